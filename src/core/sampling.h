@@ -1,0 +1,64 @@
+// Sampling routines come with their pdf (and inverse where it exists).
+#pragma once
+
+#include "core/math.h"
+
+namespace vdbmarch {
+
+// Henyey-Greenstein phase function, p(cos) with cos = dot(wo, wi) where both
+// point away from the scattering point along the light flow convention used
+// here: cosTheta is the cosine between the incoming light's travel direction
+// and the outgoing direction (g > 0 scatters forward).
+inline float hgPhase(float cosTheta, float g) {
+    float denom = 1 + g * g - 2 * g * cosTheta;
+    return Inv4Pi * (1 - g * g) / (denom * std::sqrt(std::max(denom, 1e-12f)));
+}
+
+// Samples the cosine to the travel direction with pdf hgPhase(cos, g) over the
+// sphere (times the uniform azimuth). u in [0,1).
+inline float sampleHgCosTheta(float u, float g) {
+    if (std::fabs(g) < 1e-3f) return 1 - 2 * u;
+    float s = (1 - g * g) / (1 - g + 2 * g * u);
+    return clamp((1 + g * g - s * s) / (2 * g), -1.f, 1.f);
+}
+
+// Direction around `axis` with the given cosine and azimuth u2 in [0,1).
+inline Vec3 directionAround(const Vec3& axis, float cosTheta, float u2) {
+    Vec3 s, t;
+    coordinateSystem(axis, s, t);
+    float sinTheta = safeSqrt(1 - cosTheta * cosTheta);
+    float phi = 2 * Pi * u2;
+    return s * (sinTheta * std::cos(phi)) + t * (sinTheta * std::sin(phi)) + axis * cosTheta;
+}
+
+inline Vec3 sampleUniformSphere(float u1, float u2) {
+    float z = 1 - 2 * u1;
+    float r = safeSqrt(1 - z * z), phi = 2 * Pi * u2;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float uniformSpherePdf() { return Inv4Pi; }
+
+// Uniform direction inside the cone of half-angle acos(cosMax) around axis.
+inline Vec3 sampleUniformCone(const Vec3& axis, float cosMax, float u1, float u2) {
+    float cosTheta = 1 - u1 * (1 - cosMax);
+    return directionAround(axis, cosTheta, u2);
+}
+inline float uniformConePdf(float cosMax) { return 1 / (2 * Pi * (1 - cosMax)); }
+
+// Fresnel reflectance of a smooth dielectric for unpolarised light;
+// cosI > 0 on the incident side, eta = n_transmitted / n_incident.
+inline float fresnelDielectric(float cosI, float eta, float* cosTOut = nullptr) {
+    cosI = clamp(cosI, 0.f, 1.f);
+    float sin2T = (1 - cosI * cosI) / (eta * eta);
+    if (sin2T >= 1) {
+        if (cosTOut) *cosTOut = 0;
+        return 1;  // total internal reflection
+    }
+    float cosT = safeSqrt(1 - sin2T);
+    if (cosTOut) *cosTOut = cosT;
+    float rPar = (eta * cosI - cosT) / (eta * cosI + cosT);
+    float rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
+    return 0.5f * (rPar * rPar + rPerp * rPerp);
+}
+
+}  // namespace vdbmarch

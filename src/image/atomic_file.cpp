@@ -1,0 +1,82 @@
+#include "image/atomic_file.h"
+
+#include "core/error.h"
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <utility>
+
+namespace vdbmarch {
+
+namespace {
+
+std::atomic<unsigned> gTempCounter{0};
+
+// Splits "a/b/c.exr" into "a/b" and "c.exr"; a bare name lives in ".".
+void splitPath(const std::string& path, std::string& dir, std::string& name) {
+    size_t slash = path.find_last_of('/');
+    if (slash == std::string::npos) {
+        dir = ".";
+        name = path;
+    } else {
+        dir = slash == 0 ? "/" : path.substr(0, slash);
+        name = path.substr(slash + 1);
+    }
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::string finalPath) : mFinalPath(std::move(finalPath)) {
+    std::string dir, name;
+    splitPath(mFinalPath, dir, name);
+    if (name.empty()) throw IoError(str("cannot write '", mFinalPath, "': not a file name"));
+    // pid + per-process counter keeps concurrent writers (threads or
+    // processes) from sharing a temporary file.
+    mTempPath = str(dir == "/" ? "" : dir, "/.", name, ".tmp-", ::getpid(), "-", gTempCounter++);
+}
+
+AtomicFile::~AtomicFile() {
+    if (!mCommitted) ::unlink(mTempPath.c_str());
+}
+
+void AtomicFile::commit() {
+    if (mCommitted) return;
+    // fsync before rename: otherwise a crash can leave the new name pointing
+    // at an empty file on some file systems.
+    int fd = ::open(mTempPath.c_str(), O_RDONLY);
+    if (fd < 0)
+        throw IoError(str("cannot write '", mFinalPath, "': temporary file '", mTempPath,
+                          "': ", std::strerror(errno)));
+    bool synced = ::fsync(fd) == 0 || errno == EINVAL;  // EINVAL: fs without fsync
+    int syncErr = errno;
+    ::close(fd);
+    if (!synced)
+        throw IoError(str("cannot write '", mFinalPath, "': ", std::strerror(syncErr)));
+    if (std::rename(mTempPath.c_str(), mFinalPath.c_str()) != 0)
+        throw IoError(str("cannot write '", mFinalPath, "': rename from '", mTempPath,
+                          "' failed: ", std::strerror(errno)));
+    mCommitted = true;
+}
+
+void checkWritable(const std::string& path) {
+    std::string dir, name;
+    splitPath(path, dir, name);
+    if (name.empty()) throw IoError(str("cannot write '", path, "': not a file name"));
+    struct stat st;
+    if (::stat(dir.c_str(), &st) != 0)
+        throw IoError(str("cannot write '", path, "': directory '", dir, "': ", std::strerror(errno)));
+    if (!S_ISDIR(st.st_mode))
+        throw IoError(str("cannot write '", path, "': '", dir, "' is not a directory"));
+    // Write + search permission are what creating and renaming the temp file need.
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        throw IoError(str("cannot write '", path, "': directory '", dir, "': ", std::strerror(errno)));
+    if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+        throw IoError(str("cannot write '", path, "': it is a directory"));
+}
+
+}  // namespace vdbmarch

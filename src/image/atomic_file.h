@@ -1,0 +1,37 @@
+// Write-then-rename output: a failed or interrupted run never leaves a partial
+// image at the final path nor clobbers an existing one.
+#pragma once
+
+#include <string>
+
+namespace vdbmarch {
+
+class AtomicFile {
+public:
+    explicit AtomicFile(std::string finalPath);
+    // Removes the temporary file unless commit() succeeded.
+    ~AtomicFile();
+    AtomicFile(const AtomicFile&) = delete;
+    AtomicFile& operator=(const AtomicFile&) = delete;
+
+    // Unique path in the same directory as the final path (".<name>.tmp-<pid>-<n>"),
+    // so the rename never crosses file systems. The writer creates the file.
+    const std::string& tempPath() const { return mTempPath; }
+    const std::string& finalPath() const { return mFinalPath; }
+
+    // Flushes the temporary file to disk and renames it onto the final path.
+    // Throws IoError naming the final path on failure.
+    void commit();
+
+private:
+    std::string mFinalPath;
+    std::string mTempPath;
+    bool mCommitted = false;
+};
+
+// Throws IoError if the directory that would hold `path` does not exist or is
+// not writable, or if `path` is itself a directory. Called before rendering so
+// a long render does not fail at the very end.
+void checkWritable(const std::string& path);
+
+}  // namespace vdbmarch

@@ -1,0 +1,131 @@
+#include "image/exr_io.h"
+
+#include "core/error.h"
+#include "image/atomic_file.h"
+
+#include <OpenEXR/Iex.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfTestFile.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <new>
+#include <cstdint>
+#include <utility>
+
+namespace vdbmarch {
+
+namespace {
+
+const char* const RgbaNames[4] = {"R", "G", "B", "A"};
+
+// Missing / unreadable files are IoError; everything OpenEXR rejects after
+// that is a bad input file.
+void checkReadableExr(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) throw IoError(str("cannot open '", path, "': ", std::strerror(errno)));
+    std::fclose(f);
+    if (!Imf::isOpenExrFile(path.c_str()))
+        throw InputError(str("'", path, "' is not an OpenEXR file"));
+}
+
+// Runs `fn` with an open InputFile, translating OpenEXR's exceptions into ours.
+template <typename Fn>
+auto withInputFile(const std::string& path, Fn fn) -> decltype(fn(std::declval<Imf::InputFile&>())) {
+    checkReadableExr(path);
+    try {
+        Imf::InputFile in(path.c_str());
+        return fn(in);
+    } catch (const InputError&) {
+        throw;
+    } catch (const Iex::ErrnoExc& e) {
+        throw IoError(str("cannot read '", path, "': ", e.what()));
+    } catch (const std::bad_alloc&) {
+        throw InputError(str("cannot read OpenEXR file '", path, "': out of memory (corrupt header?)"));
+    } catch (const std::exception& e) {
+        throw InputError(str("cannot read OpenEXR file '", path, "': ", e.what()));
+    }
+}
+
+}  // namespace
+
+void writeExr(const std::string& path, const Image& img, const StringAttributes& attributes) {
+    if (img.empty()) throw InputError(str("cannot write '", path, "': image is empty"));
+    if (img.rgba.size() != img.pixelCount() * 4)
+        throw InputError(str("cannot write '", path, "': pixel buffer does not match ", img.width,
+                             "x", img.height));
+
+    Imf::Header header(img.width, img.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const char* name : RgbaNames) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    for (const auto& [name, value] : attributes) {
+        // Replacing a standard attribute (e.g. "compression") or a duplicate
+        // would silently change the file; refuse instead.
+        if (name.empty() || header.find(name) != header.end())
+            throw InputError(str("cannot write '", path, "': duplicate or reserved EXR attribute name '",
+                                 name, "'"));
+        header.insert(name, Imf::StringAttribute(value));
+    }
+
+    const size_t xStride = 4 * sizeof(float), yStride = xStride * size_t(img.width);
+    // OpenEXR's Slice wants a non-const base, but only reads through it when writing.
+    char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgba.data()));
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 4; ++c)
+        fb.insert(RgbaNames[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xStride, yStride));
+
+    AtomicFile file(path);
+    try {
+        // Scoped so the file is closed (fully flushed) before the rename.
+        Imf::OutputFile out(file.tempPath().c_str(), header);
+        out.setFrameBuffer(fb);
+        out.writePixels(img.height);
+    } catch (const std::exception& e) {
+        throw IoError(str("cannot write '", path, "': ", e.what()));
+    }
+    file.commit();
+}
+
+Image readExr(const std::string& path) {
+    return withInputFile(path, [&](Imf::InputFile& in) {
+        const Imath::Box2i dw = in.header().dataWindow();
+        const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+        if (w <= 0 || h <= 0 || w > (1 << 30) / h)
+            throw InputError(str("'", path, "' has an unsupported data window of ", w, "x", h));
+        const Imf::ChannelList& channels = in.header().channels();
+        for (int c = 0; c < 3; ++c)
+            if (!channels.findChannel(RgbaNames[c]))
+                throw InputError(str("'", path, "' has no ", RgbaNames[c], " channel"));
+
+        Image img(static_cast<int>(w), static_cast<int>(h));
+        Imf::FrameBuffer fb;
+        for (int c = 0; c < 4; ++c) {
+            // A missing A channel is filled with 1 (opaque) by OpenEXR.
+            fb.insert(RgbaNames[c], Imf::Slice::Make(Imf::FLOAT, img.rgba.data() + c, dw, 4 * sizeof(float),
+                                                     4 * sizeof(float) * size_t(w), 1, 1, c == 3 ? 1.0 : 0.0));
+        }
+        in.setFrameBuffer(fb);
+        in.readPixels(dw.min.y, dw.max.y);
+        return img;
+    });
+}
+
+StringAttributes readExrStringAttributes(const std::string& path) {
+    return withInputFile(path, [](Imf::InputFile& in) {
+        StringAttributes out;
+        // Header iteration is in name order.
+        for (auto it = in.header().begin(); it != in.header().end(); ++it)
+            if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+                out.emplace_back(it.name(), s->value());
+        return out;
+    });
+}
+
+}  // namespace vdbmarch

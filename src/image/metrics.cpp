@@ -1,0 +1,115 @@
+#include "image/metrics.h"
+
+#include "core/error.h"
+#include "image/png_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace vdbmarch {
+
+namespace {
+
+// Keeps relative errors bounded where the reference is near black. 1e-2 makes
+// relMse the standard relMSE of the rendering literature (adaptive-sampling
+// and denoising papers since Rousselle et al.), so numbers are comparable.
+constexpr double RelEpsilon = 1e-2;
+
+void checkSameSize(const Image& test, const Image& reference) {
+    if (test.width != reference.width || test.height != reference.height)
+        throw InputError(str("image sizes differ: test is ", test.width, "x", test.height,
+                             ", reference is ", reference.width, "x", reference.height));
+}
+
+bool finiteRgb(const Image& img, size_t i) {
+    const float* p = &img.rgba[i * 4];
+    return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
+
+// matplotlib's viridis sampled at 10 even steps (as R viridisLite::viridis(10)).
+constexpr uint8_t Viridis[10][3] = {
+    {0x44, 0x01, 0x54}, {0x48, 0x28, 0x78}, {0x3E, 0x4A, 0x89}, {0x31, 0x68, 0x8E}, {0x26, 0x82, 0x8E},
+    {0x1F, 0x9E, 0x89}, {0x35, 0xB7, 0x79}, {0x6D, 0xCD, 0x59}, {0xB4, 0xDE, 0x2C}, {0xFD, 0xE7, 0x25},
+};
+
+void viridis(double t, uint8_t out[3]) {
+    t = clamp(t, 0.0, 1.0) * 9.0;
+    int i = std::min(int(t), 8);
+    double f = t - i;
+    for (int c = 0; c < 3; ++c)
+        out[c] = uint8_t(std::lround(Viridis[i][c] + f * (Viridis[i + 1][c] - Viridis[i][c])));
+}
+
+}  // namespace
+
+ImageErrorStats compareImages(const Image& test, const Image& reference) {
+    checkSameSize(test, reference);
+    ImageErrorStats s;
+    double sumSq = 0, sumRel = 0, sumAbsRel = 0, sumA = 0, sumB = 0;
+    for (size_t i = 0; i < test.pixelCount(); ++i) {
+        bool okA = finiteRgb(test, i), okB = finiteRgb(reference, i);
+        s.nonFiniteA += !okA;
+        s.nonFiniteB += !okB;
+        if (!okA || !okB) continue;
+        ++s.pixels;
+        for (int c = 0; c < 3; ++c) {
+            double a = test.rgba[i * 4 + c], b = reference.rgba[i * 4 + c];
+            double d = a - b;
+            sumSq += d * d;
+            sumRel += d * d / (b * b + RelEpsilon);
+            sumAbsRel += std::abs(d) / (std::abs(b) + RelEpsilon);
+            sumA += a;
+            sumB += b;
+        }
+    }
+    const double n = 3.0 * double(s.pixels);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    s.rmse = n > 0 ? std::sqrt(sumSq / n) : nan;
+    s.relMse = n > 0 ? sumRel / n : nan;
+    s.meanAbsRelError = n > 0 ? sumAbsRel / n : nan;
+    s.meanA = n > 0 ? sumA / n : nan;
+    s.meanB = n > 0 ? sumB / n : nan;
+    return s;
+}
+
+void writeFalseColorDiff(const std::string& path, const Image& test, const Image& reference) {
+    checkSameSize(test, reference);
+    const size_t count = test.pixelCount();
+    // Negative marks a pixel that is non-finite in either image.
+    std::vector<double> err(count, -1.0);
+    std::vector<double> finiteErr;
+    finiteErr.reserve(count);
+    for (size_t i = 0; i < count; ++i) {
+        if (!finiteRgb(test, i) || !finiteRgb(reference, i)) continue;
+        double e = 0;
+        for (int c = 0; c < 3; ++c) e += std::abs(double(test.rgba[i * 4 + c]) - reference.rgba[i * 4 + c]);
+        err[i] = e / 3.0;
+        finiteErr.push_back(err[i]);
+    }
+
+    double scale = 0;
+    if (!finiteErr.empty()) {
+        // Nearest-rank 99th percentile; fall back to the maximum when more than
+        // 99% of pixels match exactly, so the few differing ones still show.
+        size_t rank = size_t(std::ceil(0.99 * double(finiteErr.size()))) - 1;
+        std::nth_element(finiteErr.begin(), finiteErr.begin() + rank, finiteErr.end());
+        scale = finiteErr[rank];
+        if (scale <= 0) scale = *std::max_element(finiteErr.begin(), finiteErr.end());
+    }
+
+    std::vector<uint8_t> rgb(count * 3);
+    for (size_t i = 0; i < count; ++i) {
+        uint8_t* p = &rgb[i * 3];
+        if (err[i] < 0) {
+            p[0] = 255; p[1] = 0; p[2] = 255;
+        } else {
+            viridis(scale > 0 ? err[i] / scale : 0.0, p);
+        }
+    }
+    writePngRgb8(path, test.width, test.height, rgb);
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,211 @@
+#include "marchers/march_common.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/sampling.h"
+
+namespace vdbmarch {
+
+ThreadContext::ThreadContext(const Scene& s) : scene(s) {
+    for (const auto& m : s.media) queries.push_back(m->makeQuery());
+}
+
+void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp) {
+    mp.sigma_a = mp.sigma_s = mp.sigma_t = mp.emission = Color(0);
+    mp.count = 0;
+    for (int mi : ctx.scene.regions[size_t(region)].media) {
+        float d = ctx.queries[size_t(mi)]->density(p);
+        if (!(d > 0)) continue;
+        const Medium& m = *ctx.scene.media[size_t(mi)];
+        Color sa = m.sigma_a * d, ss = m.sigma_s * d;
+        mp.sigma_a += sa;
+        mp.sigma_s += ss;
+        if (m.hasEmission) {
+            float e = ctx.queries[size_t(mi)]->emission(p);
+            if (e > 0) mp.emission += sa * m.emissionColor * e;
+        }
+        if (!isBlack(ss) && mp.count < MaxMediaPerPoint) {
+            mp.sigmaS[mp.count] = ss;
+            mp.g[mp.count] = m.g;
+            ++mp.count;
+        }
+    }
+    mp.sigma_t = mp.sigma_a + mp.sigma_s;
+}
+
+void regionIntervals(ThreadContext& ctx, int region, const Ray& r, float tMin, float tMax,
+                     std::vector<Interval>& out) {
+    out.clear();
+    const auto& media = ctx.scene.regions[size_t(region)].media;
+    if (media.empty() || !(tMax > tMin)) return;
+    if (media.size() == 1) {
+        ctx.queries[size_t(media[0])]->activeIntervals(r, tMin, tMax, out);
+        return;
+    }
+    auto& all = ctx.scratch;
+    all.clear();
+    for (int mi : media) ctx.queries[size_t(mi)]->activeIntervals(r, tMin, tMax, all);
+    std::sort(all.begin(), all.end(), [](const Interval& a, const Interval& b) { return a.t0 < b.t0; });
+    for (const auto& iv : all) {
+        if (!out.empty() && iv.t0 <= out.back().t1) out.back().t1 = std::max(out.back().t1, iv.t1);
+        else out.push_back(iv);
+    }
+}
+
+Color scatteringPhase(const MediumPoint& mp, float cosTheta) {
+    Color c(0);
+    for (int i = 0; i < mp.count; ++i) c += mp.sigmaS[i] * hgPhase(cosTheta, mp.g[i]);
+    return c;
+}
+
+Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d) {
+    float eps = 1e-5f * std::max(scene.sceneScale, maxComponent(max(p, -p)));
+    return p + (dot(n, d) > 0 ? n : -n) * eps;
+}
+
+int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tMax, float& t) {
+    if (!scene.hasSphereLights) return -1;
+    int best = -1;
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        float ti;
+        if (scene.lights[i].intersect(r, tMin, tMax, ti)) {
+            tMax = ti;
+            t = ti;
+            best = int(i);
+        }
+    }
+    return best;
+}
+
+int regionAtRayStart(const Scene& scene, const Ray& r) {
+    SurfaceHit h;
+    if (!scene.surfaceSet->intersect(r, 0.f, Infinity, h)) return Scene::WorldRegion;
+    const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+    return dot(r.d, h.n) > 0 ? s.interiorRegion : s.exteriorRegion;
+}
+
+namespace {
+
+// Optical depth of the region's media over [0, tEnd) of ray r, by uniform
+// steps at (k + u) * step: an unbiased estimate of the integral of sigma_t.
+// Stops early once every channel's depth exceeds `depthCutoff`.
+Color opticalDepth(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng, float depthCutoff) {
+    Color tau(0);
+    const auto& media = ctx.scene.regions[size_t(region)].media;
+    if (media.empty()) return tau;
+    regionIntervals(ctx, region, r, 0.f, tEnd, ctx.shadowIntervals);
+    if (ctx.shadowIntervals.empty()) return tau;
+    if (!std::isfinite(ctx.shadowIntervals.back().t1)) return Color(Infinity);  // unbounded fog
+    const float step = ctx.scene.shadowStep;
+    const float u = rng.uniform();
+    MediumPoint mp;
+    for (const Interval& iv : ctx.shadowIntervals) {
+        float k = std::ceil(iv.t0 / step - u);
+        for (float t = (k + u) * step; t < iv.t1; k += 1, t = (k + u) * step) {
+            evalMedia(ctx, region, r.at(t), mp);
+            ++ctx.counters.shadowSamples;
+            tau += mp.sigma_t * step;
+            if (minComponent(tau) > depthCutoff) return tau;
+        }
+    }
+    return tau;
+}
+
+}  // namespace
+
+Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const Vec3& wi, float dist, Rng& rng) {
+    const Scene& scene = ctx.scene;
+    ++ctx.counters.shadowRays;
+    Ray r{p, wi};
+    float remaining = dist;
+    Color tau(0);
+    // exp(-30) ~ 1e-13: beyond that depth the light is numerically gone.
+    const float cutoff = 30.f;
+    for (int crossing = 0; crossing <= scene.desc.render.maxSurfaceBounces; ++crossing) {
+        // The target sphere light sits at `remaining`; stop just short of it.
+        float tLimit = std::isfinite(remaining) ? remaining * (1 - 1e-4f) : Infinity;
+        SurfaceHit h;
+        bool hit = scene.surfaceSet->intersect(r, 0.f, tLimit, h);
+        float tLight;
+        if (intersectSphereLights(scene, r, 1e-4f * scene.sceneScale, hit ? h.t : tLimit, tLight) >= 0)
+            return Color(0);
+        float segEnd = hit ? h.t : remaining;
+        tau += opticalDepth(ctx, region, r, segEnd, rng, cutoff - minComponent(tau));
+        if (minComponent(tau) > cutoff) return Color(0);
+        if (!hit) return exp(-tau);
+        const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+        // Glass refracts and diffuse surfaces are opaque: a straight shadow
+        // ray cannot pass them (photons carry that light in a later stage).
+        if (s.material.type != MaterialDesc::Type::Interface) return Color(0);
+        region = dot(r.d, h.n) < 0 ? s.interiorRegion : s.exteriorRegion;
+        r.o = offsetRayOrigin(scene, h.p, h.n, r.d);
+        if (std::isfinite(remaining)) remaining -= h.t;
+    }
+    return Color(0);
+}
+
+Color directInScattering(ThreadContext& ctx, int region, const Vec3& p, const Vec3& rayDir, const MediumPoint& mp,
+                         Rng& rng) {
+    Color Ls(0);
+    if (mp.count == 0) return Ls;
+    const Scene& scene = ctx.scene;
+    for (const Light& light : scene.lights) {
+        LightSample ls;
+        float u1 = rng.uniform(), u2 = rng.uniform();
+        if (!light.sample(p, u1, u2, ls) || isBlack(ls.L)) continue;
+        // cos between the light's travel direction (-wi) and the scattered
+        // direction towards the camera (-rayDir).
+        Color f = scatteringPhase(mp, dot(ls.wi, rayDir));
+        if (isBlack(f)) continue;
+        Color T = shadowTransmittance(ctx, region, p, ls.wi, ls.dist, rng);
+        Ls += f * ls.L * T;
+    }
+    if (!isBlack(scene.background)) {
+        // Constant environment: pick one medium by its scattering weight and
+        // sample its phase function; weight by the mixture pdf.
+        float total = 0, w[MaxMediaPerPoint];
+        for (int i = 0; i < mp.count; ++i) total += (w[i] = average(mp.sigmaS[i]));
+        float u = rng.uniform() * total;
+        int pick = 0;
+        while (pick + 1 < mp.count && u >= w[pick]) u -= w[pick++];
+        float cosT = sampleHgCosTheta(rng.uniform(), mp.g[pick]);
+        // Travel direction of the arriving light is -wi; the sample is drawn
+        // around the outgoing direction -rayDir, so wi lies around rayDir.
+        Vec3 wi = directionAround(rayDir, cosT, rng.uniform());
+        float cosTheta = dot(wi, rayDir);
+        float pdf = 0;
+        for (int i = 0; i < mp.count; ++i) pdf += w[i] / total * hgPhase(cosTheta, mp.g[i]);
+        if (pdf > 0) {
+            Color T = shadowTransmittance(ctx, region, p, wi, Infinity, rng);
+            Ls += scatteringPhase(mp, cosTheta) * scene.background * T / pdf;
+        }
+    }
+    return Ls;
+}
+
+Color directDiffuse(ThreadContext& ctx, int region, const Vec3& p, const Vec3& n, const Vec3& rayDir,
+                    const Color& albedo, Rng& rng) {
+    const Scene& scene = ctx.scene;
+    Vec3 nf = dot(n, rayDir) < 0 ? n : -n;  // shade the side the ray came from
+    Vec3 o = p + nf * (1e-5f * std::max(scene.sceneScale, maxComponent(max(p, -p))));
+    Color Lo(0);
+    for (const Light& light : scene.lights) {
+        LightSample ls;
+        float u1 = rng.uniform(), u2 = rng.uniform();
+        if (!light.sample(o, u1, u2, ls) || isBlack(ls.L)) continue;
+        float cosI = dot(ls.wi, nf);
+        if (cosI <= 0) continue;
+        Lo += albedo * InvPi * ls.L * cosI * shadowTransmittance(ctx, region, o, ls.wi, ls.dist, rng);
+    }
+    if (!isBlack(scene.background)) {
+        // Cosine-weighted hemisphere: the pdf cancels the cosine and 1/pi.
+        float u1 = rng.uniform(), u2 = rng.uniform();
+        float cosT = std::sqrt(1 - u1);
+        Vec3 wi = directionAround(nf, cosT, u2);
+        Lo += albedo * scene.background * shadowTransmittance(ctx, region, o, wi, Infinity, rng);
+    }
+    return Lo;
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,73 @@
+// Pieces every marcher shares: per-thread medium queries, the media of a
+// region at a point, the union of active intervals along a ray (empty space
+// skipping), shadow-ray transmittance, and direct lighting (next-event
+// estimation to every light, plus the background as a constant environment).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/math.h"
+#include "core/rng.h"
+#include "core/stats.h"
+#include "scene/scene.h"
+
+namespace vdbmarch {
+
+constexpr int MaxMediaPerPoint = 8;
+
+struct ThreadContext {
+    explicit ThreadContext(const Scene& s);
+    const Scene& scene;
+    std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
+    std::vector<Interval> intervals, shadowIntervals, scratch;
+    RenderCounters counters;
+};
+
+// Coefficients of all media of a region at one point.
+struct MediumPoint {
+    Color sigma_a, sigma_s, sigma_t;
+    Color emission;  // sigma_a * L_e, the source term of eq. 1
+    int count = 0;   // media that scatter here, for the phase mixture
+    Color sigmaS[MaxMediaPerPoint];
+    float g[MaxMediaPerPoint];
+};
+
+void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp);
+
+// Sorted, merged union of the active intervals of the region's media within
+// [tMin, tMax].
+void regionIntervals(ThreadContext& ctx, int region, const Ray& r, float tMin, float tMax,
+                     std::vector<Interval>& out);
+
+// Sum over the media at a point of sigma_s,i * p_i(cos); cos is between the
+// light's travel direction and the scattered direction.
+Color scatteringPhase(const MediumPoint& mp, float cosTheta);
+
+// Transmittance from p along direction wi over distance `dist` (Infinity for
+// the environment/directional lights), starting in `region`. Interfaces are
+// crossed (the region changes), every other surface and sphere lights block.
+// Optical depth by uniform steps with a random offset.
+Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const Vec3& wi, float dist, Rng& rng);
+
+// In-scattered radiance from direct light at p towards -rayDir, multiplied by
+// the scattering coefficients (sigma_s L_i of eq. 1 restricted to light that
+// arrives unscattered): next-event estimation to every light, and one
+// phase-sampled direction for the background environment.
+Color directInScattering(ThreadContext& ctx, int region, const Vec3& p, const Vec3& rayDir, const MediumPoint& mp,
+                         Rng& rng);
+
+// Radiance leaving a diffuse surface at hit towards -rayDir, from direct light.
+Color directDiffuse(ThreadContext& ctx, int region, const Vec3& p, const Vec3& n, const Vec3& rayDir,
+                    const Color& albedo, Rng& rng);
+
+// Offset origin for a ray leaving a surface at p in direction d.
+Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d);
+
+// Region that a ray starting at r.o is in, from the first surface it meets.
+int regionAtRayStart(const Scene& scene, const Ray& r);
+
+// Closest sphere light hit in (tMin, tMax); returns the light index or -1.
+int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tMax, float& t);
+
+}  // namespace vdbmarch

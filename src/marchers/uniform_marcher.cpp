@@ -1,0 +1,140 @@
+// Baseline (i) of the paper: ray marching with a uniform step and one random
+// offset per ray segment (eq. 5), lit by direct light through shadow rays.
+//
+// Per step of length dx at x_k the source term is integrated exactly under the
+// constant-medium assumption of eq. 5: the step contributes
+//   T_k * S(x_k, dx) * (sigma_a L_e + sigma_s L_i),  S = (1 - e^{-kappa dx}) / kappa  (eq. 7)
+// and T_{k+1} = T_k e^{-kappa dx}. S replaces eq. 5's dx so optically thick
+// steps cannot over-count (S -> dx as kappa dx -> 0).
+#include <cmath>
+
+#include "core/error.h"
+#include "core/sampling.h"
+#include "marchers/marcher.h"
+#include "scene/scene.h"
+
+namespace vdbmarch {
+
+namespace {
+
+// Below this throughput, Russian roulette decides whether a ray goes on.
+constexpr float RouletteThreshold = 1e-3f;
+
+class UniformMarcher final : public Marcher {
+public:
+    explicit UniformMarcher(const Scene& s) : mScene(s) {}
+
+    PathResult radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
+        const Scene& scene = mScene;
+        ++ctx.counters.cameraRays;
+        Color L(0), beta(1);
+        Ray ray = cameraRay;
+        int region = regionAtRayStart(scene, ray);
+        for (int bounce = 0;; ++bounce) {
+            SurfaceHit h;
+            bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
+            float tLight = Infinity;
+            int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
+            float segEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+            if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f};
+            if (light >= 0) {
+                L += beta * scene.lights[size_t(light)].emittedRadiance();
+                return {L, 0.f};
+            }
+            if (!hit) {
+                L += beta * scene.background;
+                return {L, average(beta)};
+            }
+            ++ctx.counters.surfaceHits;
+            if (bounce >= scene.desc.render.maxSurfaceBounces) return {L, 0.f};
+            const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+            bool entering = dot(ray.d, h.n) < 0;
+            switch (s.material.type) {
+                case MaterialDesc::Type::Diffuse:
+                    L += beta * directDiffuse(ctx, region, h.p, h.n, ray.d, s.material.albedo, rng);
+                    return {L, 0.f};
+                case MaterialDesc::Type::Interface:
+                    region = entering ? s.interiorRegion : s.exteriorRegion;
+                    ray.o = offsetRayOrigin(scene, h.p, h.n, ray.d);
+                    break;
+                case MaterialDesc::Type::Dielectric: {
+                    // Smooth Fresnel: reflect with probability F, else refract;
+                    // the weights F/F and (1-F)/(1-F) cancel.
+                    Vec3 n = entering ? h.n : -h.n;  // faces the incoming ray
+                    float eta = entering ? s.material.ior : 1 / s.material.ior;
+                    float cosI = -dot(ray.d, n), cosT;
+                    float F = fresnelDielectric(cosI, eta, &cosT);
+                    Vec3 d;
+                    if (rng.uniform() < F) {
+                        d = ray.d + n * (2 * cosI);
+                    } else {
+                        d = ray.d / eta + n * (cosI / eta - cosT);
+                        region = entering ? s.interiorRegion : s.exteriorRegion;
+                    }
+                    d = normalize(d);
+                    ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
+                    break;
+                }
+            }
+        }
+    }
+
+private:
+    // Marches [0, tEnd) of the ray in `region`, adding to L and attenuating
+    // beta. Returns false when Russian roulette ended the path.
+    bool marchSegment(ThreadContext& ctx, int region, const Ray& ray, float tEnd, Rng& rng, Color& L,
+                      Color& beta) const {
+        const Scene& scene = mScene;
+        if (scene.regions[size_t(region)].media.empty()) return true;
+        regionIntervals(ctx, region, ray, 0.f, tEnd, ctx.intervals);
+        double active = 0;
+        const float dx = scene.step;
+        const float u = rng.uniform();  // one random offset per segment (eq. 5 with jitter)
+        MediumPoint mp;
+        for (const Interval& iv : ctx.intervals) {
+            active += double(std::min(iv.t1, 1e30f) - iv.t0);
+            float k = std::ceil(iv.t0 / dx - u);
+            for (float t = (k + u) * dx; t < iv.t1; k += 1, t = (k + u) * dx) {
+                Vec3 x = ray.at(t);
+                evalMedia(ctx, region, x, mp);
+                ++ctx.counters.marchSamples;
+                if (isBlack(mp.sigma_t)) continue;
+                Color source = mp.emission + directInScattering(ctx, region, x, ray.d, mp, rng);
+                Color S, Tstep;
+                for (int c = 0; c < 3; ++c) {
+                    float tauStep = mp.sigma_t[c] * dx;
+                    Tstep[c] = std::exp(-tauStep);
+                    // S = (1 - e^{-tau}) / sigma_t, written to stay exact for tiny tau.
+                    S[c] = tauStep > 1e-4f ? -std::expm1(-tauStep) / mp.sigma_t[c] : dx * (1 - 0.5f * tauStep);
+                }
+                L += beta * S * source;
+                beta *= Tstep;
+                float m = maxComponent(beta);
+                if (m < RouletteThreshold) {
+                    float q = m / RouletteThreshold;
+                    if (rng.uniform() >= q) {
+                        beta = Color(0);
+                        addLengths(ctx, ray, tEnd, active);
+                        return false;
+                    }
+                    beta /= q;
+                }
+            }
+        }
+        addLengths(ctx, ray, tEnd, active);
+        return true;
+    }
+
+    static void addLengths(ThreadContext& ctx, const Ray&, float tEnd, double active) {
+        ctx.counters.marchedLength += active;
+        if (std::isfinite(tEnd)) ctx.counters.skippedLength += std::max(0.0, double(tEnd) - active);
+    }
+
+    const Scene& mScene;
+};
+
+}  // namespace
+
+std::unique_ptr<Marcher> makeUniformMarcher(const Scene& scene) { return std::make_unique<UniformMarcher>(scene); }
+
+}  // namespace vdbmarch

@@ -1,0 +1,19 @@
+// A complete scene for a bare .vdb file: the camera frames the grid's world
+// bounds, a sun-like directional light and a constant sky light it, and the
+// coefficients are chosen from the grid's density range and size so that any
+// asset reads as a cloud (optical depth ~8 across its typical chord).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scene/scene_desc.h"
+
+namespace vdbmarch {
+
+// The generated scene as JSON (what --set overrides apply to).
+nlohmann::json autoSceneJson(const std::string& vdbPath);
+
+SceneDesc loadAutoScene(const std::string& vdbPath, const std::vector<std::string>& overrides = {});
+
+}  // namespace vdbmarch

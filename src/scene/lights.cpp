@@ -1,0 +1,113 @@
+#include "scene/lights.h"
+
+#include <cmath>
+
+#include "core/sampling.h"
+
+namespace vdbmarch {
+
+Light::Light(const LightDesc& d) : mDesc(d) {
+    switch (d.type) {
+        case LightDesc::Type::Sphere:
+            mRadiance = d.power / (4 * Pi * Pi * d.radius * d.radius);
+            break;
+        case LightDesc::Type::Spot:
+            mCosCone = std::cos(radians(d.coneDeg));
+            mCosFalloffStart = std::cos(radians(d.coneDeg - d.falloffDeg));
+            break;
+        case LightDesc::Type::CollimatedQuad: {
+            // Dual basis so a point's (a, b) in h = center + a u + b v comes
+            // from two dot products even when u and v are not orthogonal.
+            mQuadNormal = cross(d.u, d.v);
+            float n2 = lengthSquared(mQuadNormal);
+            mDualU = cross(d.v, mQuadNormal) / n2;
+            mDualV = cross(mQuadNormal, d.u) / n2;
+            break;
+        }
+        default:
+            break;
+    }
+}
+
+bool Light::sample(const Vec3& x, float u1, float u2, LightSample& s) const {
+    switch (mDesc.type) {
+        case LightDesc::Type::Point: {
+            Vec3 to = mDesc.position - x;
+            float d2 = lengthSquared(to);
+            if (!(d2 > 0)) return false;
+            s.dist = std::sqrt(d2);
+            s.wi = to / s.dist;
+            s.L = mDesc.intensity / d2;
+            return true;
+        }
+        case LightDesc::Type::Spot: {
+            Vec3 to = mDesc.position - x;
+            float d2 = lengthSquared(to);
+            if (!(d2 > 0)) return false;
+            s.dist = std::sqrt(d2);
+            s.wi = to / s.dist;
+            float cosTheta = dot(-s.wi, mDesc.direction);
+            if (cosTheta <= mCosCone) return false;
+            float falloff = 1;
+            if (cosTheta < mCosFalloffStart) {
+                float t = (cosTheta - mCosCone) / (mCosFalloffStart - mCosCone);
+                falloff = t * t * (3 - 2 * t);  // smoothstep
+            }
+            s.L = mDesc.intensity * (falloff / d2);
+            return true;
+        }
+        case LightDesc::Type::Directional:
+            s.wi = -mDesc.direction;
+            s.dist = Infinity;
+            s.L = mDesc.irradiance;
+            return true;
+        case LightDesc::Type::CollimatedQuad: {
+            // Follow the beam backwards to the emitting plane.
+            float denom = dot(-mDesc.direction, mQuadNormal);
+            float t = dot(mDesc.center - x, mQuadNormal) / denom;
+            if (!(t > 0)) return false;
+            Vec3 h = x - mDesc.direction * t - mDesc.center;
+            float a = dot(h, mDualU), b = dot(h, mDualV);
+            if (std::fabs(a) > 0.5f || std::fabs(b) > 0.5f) return false;
+            s.wi = -mDesc.direction;
+            s.dist = t;
+            s.L = mDesc.irradiance;
+            return true;
+        }
+        case LightDesc::Type::Sphere: {
+            Vec3 to = mDesc.position - x;
+            float d2 = lengthSquared(to), r2 = mDesc.radius * mDesc.radius;
+            if (d2 <= r2 * 1.0001f) return false;
+            float d = std::sqrt(d2);
+            Vec3 axis = to / d;
+            // Uniform sampling of the cone of directions that sees the sphere.
+            float sin2Max = r2 / d2;
+            float cosMax = safeSqrt(1 - sin2Max);
+            if (sin2Max < 1e-6f) cosMax = 1 - 0.5f * sin2Max;  // keep 1 - cosMax accurate
+            s.wi = sampleUniformCone(axis, cosMax, u1, u2);
+            float b = dot(to, s.wi);
+            float disc = b * b - (d2 - r2);
+            s.dist = b - safeSqrt(disc);
+            if (!(s.dist > 0)) s.dist = b;
+            s.L = mRadiance / uniformConePdf(cosMax);
+            return true;
+        }
+    }
+    return false;
+}
+
+bool Light::intersect(const Ray& r, float tMin, float tMax, float& t) const {
+    if (mDesc.type != LightDesc::Type::Sphere) return false;
+    Vec3 oc = r.o - mDesc.position;
+    float b = dot(oc, r.d);
+    float c = lengthSquared(oc) - mDesc.radius * mDesc.radius;
+    float disc = b * b - c;
+    if (disc < 0) return false;
+    float sq = std::sqrt(disc);
+    float t0 = -b - sq, t1 = -b + sq;
+    if (t0 > tMin && t0 < tMax) { t = t0; return true; }
+    if (t1 > tMin && t1 < tMax) { t = t1; return true; }
+    return false;
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,39 @@
+// Light sources for next-event estimation. A sample gives the direction to
+// the light, the distance to it, and the incident quantity: irradiance (W/m^2
+// at the point, perpendicular to wi) for delta lights, radiance / pdf for area
+// lights; either way in-scattered radiance is sigma_s * phase * L * T.
+#pragma once
+
+#include "core/math.h"
+#include "scene/scene_desc.h"
+
+namespace vdbmarch {
+
+struct LightSample {
+    Vec3 wi;     // unit, from the shaded point towards the light
+    float dist;  // distance to the light along wi (Infinity: directional)
+    Color L;
+};
+
+class Light {
+public:
+    explicit Light(const LightDesc& d);
+    // False when the light cannot illuminate x (outside a spot cone, beside a
+    // collimated quad, inside a sphere light).
+    bool sample(const Vec3& x, float u1, float u2, LightSample& s) const;
+    bool isDelta() const { return mDesc.type != LightDesc::Type::Sphere; }
+    bool isSphere() const { return mDesc.type == LightDesc::Type::Sphere; }
+    // Sphere lights only: nearest hit in (tMin, tMax).
+    bool intersect(const Ray& r, float tMin, float tMax, float& t) const;
+    // Radiance leaving a sphere light's surface: power / (4 pi^2 r^2).
+    Color emittedRadiance() const { return mRadiance; }
+    const LightDesc& desc() const { return mDesc; }
+
+private:
+    LightDesc mDesc;
+    Color mRadiance;
+    float mCosCone = -1, mCosFalloffStart = -1;
+    Vec3 mQuadNormal, mDualU, mDualV;  // collimated quad plane and dual basis
+};
+
+}  // namespace vdbmarch

@@ -1,0 +1,101 @@
+#include "scene/scene.h"
+
+#include <cmath>
+
+#include "core/error.h"
+#include "volume/vdb_mesh.h"
+
+namespace vdbmarch {
+
+std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
+    auto scene = std::make_unique<Scene>();
+    scene->desc = desc;
+    scene->camera = std::make_unique<Camera>(desc.camera);
+    scene->background = desc.background;
+    for (const auto& l : desc.lights) {
+        scene->lights.emplace_back(l);
+        scene->hasSphereLights = scene->hasSphereLights || l.type == LightDesc::Type::Sphere;
+    }
+
+    // Media: a medium named as some surface's interior lives only there.
+    std::vector<bool> isInterior(desc.media.size(), false);
+    for (const auto& s : desc.surfaces)
+        for (size_t i = 0; i < desc.media.size(); ++i)
+            if (desc.media[i].name == s.interior) isInterior[i] = true;
+    scene->regions.resize(2 + desc.media.size());
+    BBox bounds;
+    for (size_t i = 0; i < desc.media.size(); ++i) {
+        const MediumDesc& md = desc.media[i];
+        std::unique_ptr<Medium> m =
+            md.type == MediumDesc::Type::Vdb ? loadVdbMedium(md) : makeHomogeneousMedium(md);
+        if (!m->isVacuum() || m->hasEmission) {
+            scene->regions[2 + i].media.push_back(int(i));
+            if (!isInterior[i]) scene->regions[Scene::WorldRegion].media.push_back(int(i));
+            BBox b = m->worldBounds();
+            if (std::isfinite(b.lo.x) && std::isfinite(b.hi.x)) bounds.expand(b);
+        }
+        scene->media.push_back(std::move(m));
+    }
+
+    // Surfaces.
+    scene->surfaceSet = std::make_unique<SurfaceSet>();
+    auto mediumIndex = [&](const std::string& name) {
+        for (size_t i = 0; i < desc.media.size(); ++i)
+            if (desc.media[i].name == name) return int(i);
+        return -1;
+    };
+    for (size_t i = 0; i < desc.surfaces.size(); ++i) {
+        const SurfaceDesc& sd = desc.surfaces[i];
+        SurfaceInfo info;
+        info.material = sd.material;
+        if (!sd.interior.empty()) info.interiorRegion = 2 + mediumIndex(sd.interior);
+        if (!sd.exterior.empty()) info.exteriorRegion = 2 + mediumIndex(sd.exterior);
+        scene->surfaces.push_back(info);
+        Transform xf(sd.transform, str(desc.file, ": surfaces[", i, "].transform").c_str());
+        if (sd.shape == SurfaceDesc::Shape::Sphere) {
+            scene->surfaceSet->addSphere(xf, int(i));
+            for (int c = 0; c < 8; ++c)
+                bounds.expand(xf.point(Vec3(c & 1 ? 1.f : -1.f, c & 2 ? 1.f : -1.f, c & 4 ? 1.f : -1.f)));
+            continue;
+        }
+        TriangleMesh mesh;
+        if (sd.shape == SurfaceDesc::Shape::Box) mesh = makeUnitBox();
+        else if (sd.shape == SurfaceDesc::Shape::Mesh) mesh = loadMesh(sd.file);
+        else mesh = meshVdbIsosurface(sd.file, sd.grid, sd.isovalue);
+        transformMesh(mesh, [&](const Vec3& p) { return xf.point(p); });
+        if (sd.shape == SurfaceDesc::Shape::Mesh && !isClosed(mesh)) {
+            if (!sd.interior.empty())
+                warn(str(desc.file, ": surfaces[", i, "] (", sd.file,
+                         ") is not a closed mesh, but it names an interior medium: rays may leak in or out"));
+        } else if (sd.shape == SurfaceDesc::Shape::Mesh) {
+            orientOutward(mesh);
+        }
+        for (const auto& p : mesh.positions) bounds.expand(p);
+        scene->surfaceSet->addMesh(std::move(mesh), int(i));
+    }
+    scene->surfaceSet->commit();
+    for (const auto& l : desc.lights) {
+        if (l.type == LightDesc::Type::Sphere) {
+            bounds.expand(l.position - Vec3(l.radius));
+            bounds.expand(l.position + Vec3(l.radius));
+        } else if (l.type == LightDesc::Type::Point || l.type == LightDesc::Type::Spot) {
+            bounds.expand(l.position);
+        }
+    }
+    bounds.expand(desc.camera.position);
+    scene->sceneScale = bounds.empty() ? 1.f : std::max(1e-3f, maxComponent(max(-bounds.lo, bounds.hi)));
+
+    // Step: one voxel of the finest grid, else a tenth of the smallest mean free path.
+    float voxel = Infinity, maxSigmaT = 0;
+    for (const auto& m : scene->media) {
+        if (m->isVacuum() && !m->hasEmission) continue;
+        if (m->minVoxelSize() > 0) voxel = std::min(voxel, m->minVoxelSize());
+        else maxSigmaT = std::max(maxSigmaT, maxComponent(m->sigma_a + m->sigma_s) * m->maxDensity());
+    }
+    float autoStep = std::isfinite(voxel) ? voxel : (maxSigmaT > 0 ? 0.1f / maxSigmaT : 1.f);
+    scene->step = desc.render.step > 0 ? desc.render.step : autoStep;
+    scene->shadowStep = desc.render.shadowStep > 0 ? desc.render.shadowStep : scene->step;
+    return scene;
+}
+
+}  // namespace vdbmarch

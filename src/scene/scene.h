@@ -1,0 +1,49 @@
+// The loaded scene: media read from VDB files, surfaces in Embree, lights,
+// camera, and the medium regions that say which media fill which space.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "scene/camera.h"
+#include "scene/lights.h"
+#include "scene/scene_desc.h"
+#include "scene/surfaces.h"
+#include "volume/medium.h"
+
+namespace vdbmarch {
+
+// A region is a set of media that add up: the world media (outside closed
+// surfaces), vacuum, or the single medium inside a surface.
+struct Region {
+    std::vector<int> media;
+};
+
+struct SurfaceInfo {
+    MaterialDesc material;
+    int interiorRegion = 1;  // vacuum unless `interior` names a medium
+    int exteriorRegion = 0;  // the world media unless `exterior` names one
+};
+
+class Scene {
+public:
+    static constexpr int WorldRegion = 0;
+    static constexpr int VacuumRegion = 1;
+
+    SceneDesc desc;
+    std::unique_ptr<Camera> camera;
+    std::vector<Light> lights;
+    std::vector<std::unique_ptr<Medium>> media;
+    std::vector<Region> regions;
+    std::vector<SurfaceInfo> surfaces;
+    std::unique_ptr<SurfaceSet> surfaceSet;
+    Color background;
+    float step = 1, shadowStep = 1;  // world units
+    float sceneScale = 1;            // size of the scene, for ray offsets
+    bool hasSphereLights = false;
+};
+
+// Loads every file the description names and validates the combination.
+std::unique_ptr<Scene> buildScene(const SceneDesc& desc);
+
+}  // namespace vdbmarch

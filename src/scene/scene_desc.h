@@ -1,0 +1,102 @@
+// The scene as the user described it: plain data parsed from JSON (or built
+// for a bare .vdb), before any file is loaded. Loading happens in scene.cpp.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/math.h"
+#include "core/transform.h"
+
+namespace vdbmarch {
+
+struct CameraDesc {
+    enum class Type { Perspective, Orthographic } type = Type::Perspective;
+    Vec3 position{0, 0, 5}, lookAt{0, 0, 0}, up{0, 1, 0};
+    float fovDeg = 40;      // vertical, perspective
+    float widthWorld = 2;   // frame width, orthographic
+    int width = 640, height = 480;
+};
+
+struct LightDesc {
+    enum class Type { Point, Spot, Directional, CollimatedQuad, Sphere } type = Type::Point;
+    Vec3 position, direction{0, -1, 0}, center, u{1, 0, 0}, v{0, 0, 1};
+    Color intensity, irradiance, power;
+    float coneDeg = 30, falloffDeg = 5, radius = 1;
+};
+
+struct MediumDesc {
+    enum class Type { Homogeneous, Vdb } type = Type::Homogeneous;
+    std::string name;
+    Color sigma_a, sigma_s;
+    float g = 0;
+    bool hasBounds = false;
+    BBox bounds;
+    // VDB only
+    std::string file, grid = "density";
+    float densityScale = 1;
+    bool hasEmission = false;
+    std::string emissionGrid = "temperature";
+    float emissionScale = 1;
+    Color emissionColor{1, 1, 1};
+    Mat4 transform = Mat4::identity();
+};
+
+struct MaterialDesc {
+    enum class Type { Dielectric, Diffuse, Interface } type = Type::Dielectric;
+    float ior = 1.5f;
+    Color albedo{0.5f, 0.5f, 0.5f};
+};
+
+struct SurfaceDesc {
+    enum class Shape { Sphere, Box, Mesh, VdbIsosurface } shape = Shape::Sphere;
+    std::string file, grid = "density";
+    float isovalue = 0.5f;
+    Mat4 transform = Mat4::identity();
+    MaterialDesc material;
+    std::string interior, exterior;  // empty: vacuum inside / world media outside
+};
+
+struct RenderSettings {
+    std::string method = "uniform";
+    int spp = 1;
+    float step = 0;        // world units; 0 = automatic
+    float shadowStep = 0;  // 0 = same as step
+    int maxDepth = 1;
+    uint64_t seed = 0;
+    int threads = 0;       // 0 = all cores
+    int maxSurfaceBounces = 32;
+    bool pixelJitter = true;  // false: one ray through each pixel centre
+    float exposure = 0;       // PNG preview, stops
+};
+
+struct SceneDesc {
+    std::string file;     // scene file (or .vdb) the description came from
+    std::string baseDir;  // relative paths resolve against this
+    CameraDesc camera;
+    std::vector<LightDesc> lights;
+    std::vector<MediumDesc> media;
+    std::vector<SurfaceDesc> surfaces;
+    Color background{0, 0, 0};
+    RenderSettings render;
+    nlohmann::json json;  // the effective document, recorded in outputs
+};
+
+// Parses scene JSON text; `file` is used in messages and to resolve paths.
+// Throws InputError with file, line and column for malformed JSON, and with
+// the key path and bad value for semantic errors.
+SceneDesc parseSceneText(const std::string& text, const std::string& file,
+                         const std::vector<std::string>& overrides = {});
+// Reads and parses a scene file.
+SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides = {});
+// Applies one "key.path=value" override (value parsed as JSON, else string).
+void applyOverride(nlohmann::json& doc, const std::string& assignment);
+// Parses an already-built document (used for bare .vdb scenes).
+SceneDesc parseSceneJson(const nlohmann::json& doc, const std::string& file);
+
+std::string resolvePath(const std::string& baseDir, const std::string& path);
+
+}  // namespace vdbmarch

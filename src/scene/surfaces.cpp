@@ -1,0 +1,149 @@
+#include "scene/surfaces.h"
+
+#include <embree3/rtcore.h>
+
+#include <mutex>
+
+#include "core/error.h"
+
+namespace vdbmarch {
+
+// Embree reports errors through one device callback; they are collected and
+// rethrown as exceptions at the next checkpoint.
+struct SurfaceSet::Embree {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    RTCScene unitSphere = nullptr;
+    std::mutex errorMutex;
+    std::string error;
+    std::vector<unsigned> geomToIndex;  // Embree geometry ID -> mGeometries index
+
+    void check(const char* what) {
+        std::lock_guard<std::mutex> lock(errorMutex);
+        if (!error.empty()) {
+            std::string e = error;
+            error.clear();
+            throw std::runtime_error(str("Embree error during ", what, ": ", e));
+        }
+    }
+};
+
+static void embreeErrorCallback(void* user, RTCError code, const char* message) {
+    auto* e = static_cast<SurfaceSet::Embree*>(user);
+    std::lock_guard<std::mutex> lock(e->errorMutex);
+    e->error = str("code ", int(code), ": ", message ? message : "");
+}
+
+SurfaceSet::SurfaceSet() : mEmbree(std::make_unique<Embree>()) {
+    mEmbree->device = rtcNewDevice("threads=0");
+    if (!mEmbree->device) throw std::runtime_error(str("Embree: cannot create a device (error ", int(rtcGetDeviceError(nullptr)), ")"));
+    rtcSetDeviceErrorFunction(mEmbree->device, embreeErrorCallback, mEmbree.get());
+    mEmbree->scene = rtcNewScene(mEmbree->device);
+    rtcSetSceneFlags(mEmbree->scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(mEmbree->scene, RTC_BUILD_QUALITY_HIGH);
+}
+
+SurfaceSet::~SurfaceSet() {
+    if (mEmbree->unitSphere) rtcReleaseScene(mEmbree->unitSphere);
+    if (mEmbree->scene) rtcReleaseScene(mEmbree->scene);
+    if (mEmbree->device) rtcReleaseDevice(mEmbree->device);
+}
+
+void SurfaceSet::addMesh(TriangleMesh mesh, int surfaceIndex) {
+    RTCGeometry g = rtcNewGeometry(mEmbree->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), mesh.positions.size()));
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+        v[3 * i] = mesh.positions[i].x;
+        v[3 * i + 1] = mesh.positions[i].y;
+        v[3 * i + 2] = mesh.positions[i].z;
+    }
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(unsigned), mesh.triangleCount()));
+    std::copy(mesh.indices.begin(), mesh.indices.end(), idx);
+    rtcCommitGeometry(g);
+    unsigned id = rtcAttachGeometry(mEmbree->scene, g);
+    rtcReleaseGeometry(g);
+    mEmbree->check("adding a mesh");
+    if (mEmbree->geomToIndex.size() <= id) mEmbree->geomToIndex.resize(id + 1);
+    mEmbree->geomToIndex[id] = unsigned(mGeometries.size());
+    mGeometries.push_back({surfaceIndex, false, std::move(mesh), Transform()});
+}
+
+void SurfaceSet::addSphere(const Transform& toWorld, int surfaceIndex) {
+    if (!mEmbree->unitSphere) {
+        mEmbree->unitSphere = rtcNewScene(mEmbree->device);
+        RTCGeometry s = rtcNewGeometry(mEmbree->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        auto* p = static_cast<float*>(
+            rtcSetNewGeometryBuffer(s, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+        p[0] = p[1] = p[2] = 0;
+        p[3] = 1;
+        rtcCommitGeometry(s);
+        rtcAttachGeometry(mEmbree->unitSphere, s);
+        rtcReleaseGeometry(s);
+        rtcCommitScene(mEmbree->unitSphere);
+    }
+    RTCGeometry inst = rtcNewGeometry(mEmbree->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, mEmbree->unitSphere);
+    float xfm[12];  // 3x4 column-major
+    const Mat4& m = toWorld.matrix();
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = float(m.m[r][c]);
+    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    rtcCommitGeometry(inst);
+    unsigned id = rtcAttachGeometry(mEmbree->scene, inst);
+    rtcReleaseGeometry(inst);
+    mEmbree->check("adding a sphere");
+    if (mEmbree->geomToIndex.size() <= id) mEmbree->geomToIndex.resize(id + 1);
+    mEmbree->geomToIndex[id] = unsigned(mGeometries.size());
+    mGeometries.push_back({surfaceIndex, true, TriangleMesh(), toWorld});
+}
+
+void SurfaceSet::commit() {
+    rtcCommitScene(mEmbree->scene);
+    mEmbree->check("building the surface BVH");
+}
+
+size_t SurfaceSet::primitiveCount() const {
+    size_t n = 0;
+    for (const auto& g : mGeometries) n += g.sphere ? 1 : g.mesh.triangleCount();
+    return n;
+}
+
+bool SurfaceSet::intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit) const {
+    if (mGeometries.empty()) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = r.o.x; rh.ray.org_y = r.o.y; rh.ray.org_z = r.o.z;
+    rh.ray.dir_x = r.d.x; rh.ray.dir_y = r.d.y; rh.ray.dir_z = r.d.z;
+    rh.ray.tnear = tMin;
+    rh.ray.tfar = std::min(tMax, 3.0e38f);
+    rh.ray.mask = 0xFFFFFFFF;
+    rh.ray.flags = 0;
+    rh.ray.time = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(mEmbree->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    unsigned top = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
+    const Geometry& g = mGeometries[mEmbree->geomToIndex[top]];
+    hit.t = rh.ray.tfar;
+    hit.p = r.at(hit.t);
+    hit.surface = g.surface;
+    if (g.sphere) {
+        // Exact normal: the object-space point is its own normal.
+        Vec3 q = g.toWorld.inverse().point(hit.p);
+        hit.n = normalize(g.toWorld.normal(q));
+    } else {
+        const uint32_t* tri = &g.mesh.indices[3 * size_t(rh.hit.primID)];
+        const Vec3& a = g.mesh.positions[tri[0]];
+        const Vec3& b = g.mesh.positions[tri[1]];
+        const Vec3& c = g.mesh.positions[tri[2]];
+        hit.n = normalize(cross(b - a, c - a));
+    }
+    if (!isFinite(hit.n)) hit.n = -r.d;  // degenerate triangle: treat as facing the ray
+    return true;
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,52 @@
+// Surfaces (glass, diffuse and medium interfaces) intersected with Embree 3.
+// Meshes are stored in world space; spheres (ellipsoids after transform) are
+// instances of one exact unit sphere.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/math.h"
+#include "core/transform.h"
+#include "scene/mesh.h"
+#include "scene/scene_desc.h"
+
+namespace vdbmarch {
+
+struct SurfaceHit {
+    float t = Infinity;
+    Vec3 p;
+    Vec3 n;        // unit geometric normal, pointing outwards
+    int surface = -1;
+};
+
+class SurfaceSet {
+public:
+    SurfaceSet();
+    ~SurfaceSet();
+    SurfaceSet(const SurfaceSet&) = delete;
+    SurfaceSet& operator=(const SurfaceSet&) = delete;
+
+    void addMesh(TriangleMesh worldMesh, int surfaceIndex);
+    void addSphere(const Transform& objectToWorld, int surfaceIndex);
+    void commit();
+    bool empty() const { return mGeometries.empty(); }
+    // Closest hit with t in (tMin, tMax).
+    bool intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit) const;
+    // Number of triangles and spheres, for stats.
+    size_t primitiveCount() const;
+
+    struct Embree;  // Embree handles and the error callback's state
+
+private:
+    struct Geometry {
+        int surface;
+        bool sphere;
+        TriangleMesh mesh;
+        Transform toWorld;
+    };
+    std::unique_ptr<Embree> mEmbree;
+    std::vector<Geometry> mGeometries;
+};
+
+}  // namespace vdbmarch

@@ -1,0 +1,69 @@
+// Participating media: a homogeneous box (or all space) and VDB density grids.
+// The interface hides OpenVDB so that only src/volume/*.cpp include its heavy
+// headers. Per-thread state (VDB accessors, DDA scratch) lives in a
+// MediumQuery made once per tile.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "scene/scene_desc.h"
+
+namespace vdbmarch {
+
+class MediumQuery {
+public:
+    virtual ~MediumQuery() = default;
+    // Density (grid value x density_scale, sanitised >= 0) at a world point.
+    virtual float density(const Vec3& p) = 0;
+    // scale x emission grid value at a world point (0 without emission).
+    virtual float emission(const Vec3& p) = 0;
+    // Appends the parametric intervals of ray r within [tMin, tMax] where the
+    // density may be non-zero, in increasing order. Everything outside them is
+    // empty space that the marchers skip.
+    virtual void activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) = 0;
+};
+
+class Medium {
+public:
+    virtual ~Medium() = default;
+    virtual std::unique_ptr<MediumQuery> makeQuery() const = 0;
+    // World bounds of the region with density (infinite for unbounded fog).
+    virtual BBox worldBounds() const = 0;
+    // Smallest world-space voxel edge (0 for homogeneous media).
+    virtual float minVoxelSize() const { return 0; }
+    virtual float maxDensity() const = 0;
+    virtual size_t activeVoxelCount() const { return 0; }
+    // True when the medium can never attenuate or emit (skip it entirely).
+    bool isVacuum() const {
+        return maxDensity() <= 0 || (isBlack(sigma_a) && isBlack(sigma_s));
+    }
+
+    std::string name;
+    Color sigma_a, sigma_s;  // per world unit, per unit density
+    float g = 0;
+    bool hasEmission = false;
+    Color emissionColor{0, 0, 0};
+};
+
+std::unique_ptr<Medium> makeHomogeneousMedium(const MediumDesc& desc);
+// Loads the VDB file; throws InputError naming the file and grid on failure.
+std::unique_ptr<Medium> loadVdbMedium(const MediumDesc& desc);
+
+// Summary of a VDB grid, used to build a scene for a bare .vdb file.
+struct VdbGridSummary {
+    std::string gridName;
+    BBox worldBounds;
+    float voxelSize = 0;      // smallest world voxel edge
+    size_t activeVoxels = 0;
+    float minValue = 0, maxValue = 0, meanValue = 0;  // over active values
+};
+// Picks `grid`, or when empty the grid named "density", else the first float grid.
+VdbGridSummary summarizeVdb(const std::string& file, const std::string& grid);
+
+// Names and types of every grid in a file ("density (float)", ...).
+std::vector<std::string> listVdbGrids(const std::string& file);
+
+}  // namespace vdbmarch

@@ -1,0 +1,389 @@
+// VDB density media: loading (with sanitising), trilinear sampling in index
+// space, and empty-space skipping with OpenVDB's hierarchical DDA over a
+// dilated copy of the active topology. One of the few files that include
+// OpenVDB headers.
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/math/DDA.h>
+#include <openvdb/math/Ray.h>
+#include <openvdb/tools/Morphology.h>
+
+#include "core/error.h"
+#include "core/transform.h"
+#include "volume/medium.h"
+#include "volume/vdb_io.h"
+
+namespace vdbmarch {
+
+namespace {
+
+using FloatTree = openvdb::FloatTree;
+using LeafT = FloatTree::LeafNodeType;
+using BoolTree = openvdb::BoolTree;
+using VdbRay = openvdb::math::Ray<double>;
+
+void initOpenVdb() {
+    static std::once_flag once;
+    std::call_once(once, [] { openvdb::initialize(); });
+}
+
+std::string gridTypeName(const openvdb::GridBase& g) {
+    std::string t = g.valueType();
+    return t;
+}
+
+// Opens a VDB file, turning OpenVDB's exceptions into messages that name it.
+std::unique_ptr<openvdb::io::File> openVdbFile(const std::string& path) {
+    initOpenVdb();
+    {
+        std::ifstream probe(path, std::ios::binary);
+        if (!probe) throw IoError(str(path, ": cannot open VDB file: ", std::strerror(errno)));
+    }
+    auto file = std::make_unique<openvdb::io::File>(path);
+    try {
+        file->open(/*delayLoad=*/false);
+    } catch (const std::exception& e) {
+        throw InputError(str(path, ": not a readable OpenVDB file (", e.what(), ")"));
+    }
+    return file;
+}
+
+std::string gridListing(openvdb::io::File& file) {
+    std::string names;
+    auto grids = file.readAllGridMetadata();
+    for (const auto& g : *grids) names += str(names.empty() ? "" : ", ", "'", g->getName(), "' (", gridTypeName(*g), ")");
+    return names.empty() ? "none" : names;
+}
+
+// NaN, Inf and negative values become 0 (counted, one warning); inactive
+// values and the background become 0 so that "inactive" means "empty".
+void sanitize(openvdb::FloatGrid& grid, const std::string& what) {
+    size_t bad = 0;
+    for (auto it = grid.tree().beginValueAll(); it; ++it) {
+        float v = *it;
+        if (!it.isValueOn()) {
+            if (v != 0) it.setValue(0.f);
+            continue;
+        }
+        if (!std::isfinite(v) || v < 0) {
+            ++bad;
+            it.setValue(0.f);
+        }
+    }
+    float bg = grid.background();
+    if (bg != 0) {
+        if (std::isfinite(bg) && bg > 0)
+            warn(str(what, ": background value ", bg, " ignored: space outside the active voxels is empty"));
+        grid.tree().root().setBackground(0.f, /*updateChildNodes=*/true);
+    }
+    if (bad > 0) warn(str(what, ": ", bad, " NaN, Inf or negative value", bad == 1 ? "" : "s", " set to 0"));
+}
+
+// Index->world of the grid's own (linear) transform, followed by the scene's.
+Mat4 indexToWorldMatrix(const openvdb::FloatGrid& grid, const Mat4& scene, const std::string& what) {
+    const openvdb::math::Transform& xf = grid.transform();
+    if (!xf.isLinear())
+        throw InputError(str(what, ": the grid's transform (", xf.mapType(),
+                             ") is not linear; only affine grid transforms are supported"));
+    openvdb::Vec3d o = xf.indexToWorld(openvdb::Vec3d(0, 0, 0));
+    Mat4 m = Mat4::identity();
+    for (int c = 0; c < 3; ++c) {
+        openvdb::Vec3d e(0, 0, 0);
+        e[c] = 1;
+        openvdb::Vec3d col = xf.indexToWorld(e) - o;
+        for (int r = 0; r < 3; ++r) m.m[r][c] = col[r];
+    }
+    for (int r = 0; r < 3; ++r) m.m[r][3] = o[r];
+    return scene * m;
+}
+
+struct Affine {  // 3x4, double: index coordinates of large grids need it
+    double m[3][4];
+    explicit Affine(const Mat4& a) {
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) m[r][c] = a.m[r][c];
+    }
+    openvdb::Vec3d point(const Vec3& p) const {
+        return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
+                m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
+                m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
+    }
+    openvdb::Vec3d vector(const Vec3& v) const {
+        return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+                m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+    }
+};
+
+// Trilinear interpolation between voxel centres (integer index coordinates).
+// Fast path: all eight corners in one leaf, read straight from its buffer.
+inline float sampleTrilinear(openvdb::FloatGrid::ConstAccessor& acc, const openvdb::Vec3d& p) {
+    const double fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
+    const int ix = int(fx), iy = int(fy), iz = int(fz);
+    const float tx = float(p.x() - fx), ty = float(p.y() - fy), tz = float(p.z() - fz);
+    const openvdb::Coord c(ix, iy, iz);
+    float v[8];
+    const LeafT* leaf = acc.probeConstLeaf(c);
+    if (leaf && (ix & 7) != 7 && (iy & 7) != 7 && (iz & 7) != 7) {
+        const float* d = leaf->buffer().data();
+        const openvdb::Index o = LeafT::coordToOffset(c);
+        v[0] = d[o];       v[1] = d[o + 1];       v[2] = d[o + 8];       v[3] = d[o + 9];
+        v[4] = d[o + 64];  v[5] = d[o + 65];      v[6] = d[o + 72];      v[7] = d[o + 73];
+    } else if (!leaf && !acc.isValueOn(c) && (ix & 7) != 7 && (iy & 7) != 7 && (iz & 7) != 7) {
+        // Inside an inactive tile (value 0) that also covers the +1 neighbours.
+        return 0.f;
+    } else {
+        v[0] = acc.getValue(c);
+        v[1] = acc.getValue(c.offsetBy(0, 0, 1));
+        v[2] = acc.getValue(c.offsetBy(0, 1, 0));
+        v[3] = acc.getValue(c.offsetBy(0, 1, 1));
+        v[4] = acc.getValue(c.offsetBy(1, 0, 0));
+        v[5] = acc.getValue(c.offsetBy(1, 0, 1));
+        v[6] = acc.getValue(c.offsetBy(1, 1, 0));
+        v[7] = acc.getValue(c.offsetBy(1, 1, 1));
+    }
+    // v index bits: x*4 + y*2 + z
+    float a00 = v[0] + (v[1] - v[0]) * tz, a01 = v[2] + (v[3] - v[2]) * tz;
+    float a10 = v[4] + (v[5] - v[4]) * tz, a11 = v[6] + (v[7] - v[6]) * tz;
+    float b0 = a00 + (a01 - a00) * ty, b1 = a10 + (a11 - a10) * ty;
+    return b0 + (b1 - b0) * tx;
+}
+
+class VdbMedium;
+
+class VdbQuery final : public MediumQuery {
+public:
+    explicit VdbQuery(const VdbMedium& m);
+    float density(const Vec3& p) override;
+    float emission(const Vec3& p) override;
+    void activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) override;
+
+private:
+    const VdbMedium& mMedium;
+    openvdb::FloatGrid::ConstAccessor mDensity;
+    std::unique_ptr<openvdb::FloatGrid::ConstAccessor> mEmission;
+    openvdb::tree::ValueAccessor<const BoolTree> mTopology;
+    openvdb::math::VolumeHDDA<BoolTree, VdbRay, 0> mHdda;
+    std::vector<VdbRay::TimeSpan> mSpans;
+};
+
+class VdbMedium final : public Medium {
+public:
+    explicit VdbMedium(const MediumDesc& d) : mW2I(Mat4::identity()), mEmissionW2I(Mat4::identity()) {
+        name = d.name;
+        sigma_a = d.sigma_a;
+        sigma_s = d.sigma_s;
+        g = d.g;
+        const std::string what = str(d.file, ": grid '", d.grid, "'");
+        mDensity = readFloatGrid(d.file, d.grid);
+        sanitize(*mDensity, what);
+        mScale = d.densityScale;
+        Mat4 i2w = indexToWorldMatrix(*mDensity, d.transform, what);
+        mW2I = Affine(i2w.inverse(what.c_str()));
+        // World-space length of each index axis; the step default uses the smallest.
+        mMinVoxel = Infinity;
+        for (int c = 0; c < 3; ++c) {
+            double len = std::sqrt(i2w.m[0][c] * i2w.m[0][c] + i2w.m[1][c] * i2w.m[1][c] + i2w.m[2][c] * i2w.m[2][c]);
+            mMinVoxel = std::min(mMinVoxel, float(len));
+        }
+        mActiveVoxels = mDensity->activeVoxelCount();
+        float lo = 0, hi = 0;
+        bool any = false;
+        for (auto it = mDensity->cbeginValueOn(); it; ++it) {
+            if (!any) lo = hi = *it;
+            lo = std::min(lo, *it);
+            hi = std::max(hi, *it);
+            any = true;
+        }
+        mMaxDensity = hi * mScale;
+        if (mActiveVoxels == 0 || mMaxDensity <= 0) {
+            warn(str(what, " has no active voxels with density > 0: the medium is empty"));
+            mMaxDensity = 0;
+        }
+        // Topology dilated by one voxel in all 26 directions: trilinear
+        // lookups reach the +1 neighbours, so a point is non-empty iff its
+        // floor voxel is active in the dilated tree.
+        mTopology = std::make_unique<BoolTree>(mDensity->tree(), false, openvdb::TopologyCopy());
+        openvdb::tools::dilateActiveValues(*mTopology, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                           openvdb::tools::IGNORE_TILES);
+        openvdb::CoordBBox ib;
+        mTopology->evalActiveVoxelBoundingBox(ib);
+        mIndexLo = openvdb::Vec3d(ib.min().x(), ib.min().y(), ib.min().z());
+        mIndexHi = openvdb::Vec3d(ib.max().x() + 1, ib.max().y() + 1, ib.max().z() + 1);
+        if (mMaxDensity > 0)
+            for (int i = 0; i < 8; ++i) {
+                Vec3 corner(float(i & 1 ? mIndexHi.x() : mIndexLo.x()), float(i & 2 ? mIndexHi.y() : mIndexLo.y()),
+                            float(i & 4 ? mIndexHi.z() : mIndexLo.z()));
+                Vec3 w(float(i2w.m[0][0] * corner.x + i2w.m[0][1] * corner.y + i2w.m[0][2] * corner.z + i2w.m[0][3]),
+                       float(i2w.m[1][0] * corner.x + i2w.m[1][1] * corner.y + i2w.m[1][2] * corner.z + i2w.m[1][3]),
+                       float(i2w.m[2][0] * corner.x + i2w.m[2][1] * corner.y + i2w.m[2][2] * corner.z + i2w.m[2][3]));
+                mWorldBounds.expand(w);
+            }
+        if (d.hasEmission) {
+            const std::string ewhat = str(d.file, ": emission grid '", d.emissionGrid, "'");
+            mEmissionGrid = readFloatGrid(d.file, d.emissionGrid);
+            sanitize(*mEmissionGrid, ewhat);
+            mEmissionW2I = Affine(indexToWorldMatrix(*mEmissionGrid, d.transform, ewhat).inverse(ewhat.c_str()));
+            mEmissionScale = d.emissionScale;
+            hasEmission = d.emissionScale > 0 && !isBlack(d.emissionColor) && !isBlack(d.sigma_a);
+            emissionColor = d.emissionColor;
+        }
+    }
+
+    std::unique_ptr<MediumQuery> makeQuery() const override { return std::make_unique<VdbQuery>(*this); }
+    BBox worldBounds() const override { return mWorldBounds; }
+    float minVoxelSize() const override { return mMinVoxel; }
+    float maxDensity() const override { return mMaxDensity; }
+    size_t activeVoxelCount() const override { return mActiveVoxels; }
+
+private:
+    friend class VdbQuery;
+    openvdb::FloatGrid::Ptr mDensity, mEmissionGrid;
+    std::unique_ptr<BoolTree> mTopology;
+    Affine mW2I, mEmissionW2I;
+    openvdb::Vec3d mIndexLo, mIndexHi;
+    BBox mWorldBounds;
+    float mScale = 1, mEmissionScale = 0, mMinVoxel = 0, mMaxDensity = 0;
+    size_t mActiveVoxels = 0;
+};
+
+VdbQuery::VdbQuery(const VdbMedium& m)
+    : mMedium(m), mDensity(m.mDensity->getConstAccessor()), mTopology(*m.mTopology) {
+    if (m.mEmissionGrid) mEmission = std::make_unique<openvdb::FloatGrid::ConstAccessor>(m.mEmissionGrid->getConstAccessor());
+}
+
+float VdbQuery::density(const Vec3& p) {
+    return sampleTrilinear(mDensity, mMedium.mW2I.point(p)) * mMedium.mScale;
+}
+
+float VdbQuery::emission(const Vec3& p) {
+    if (!mEmission) return 0;
+    return sampleTrilinear(*mEmission, mMedium.mEmissionW2I.point(p)) * mMedium.mEmissionScale;
+}
+
+void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) {
+    if (mMedium.mMaxDensity <= 0) return;
+    // The index-space ray keeps the world parameter t: its direction is the
+    // (unnormalised) image of the world direction.
+    openvdb::Vec3d eye = mMedium.mW2I.point(r.o), dir = mMedium.mW2I.vector(r.d);
+    double t0 = tMin, t1 = tMax;
+    for (int a = 0; a < 3; ++a) {
+        if (dir[a] == 0) {
+            if (eye[a] < mMedium.mIndexLo[a] || eye[a] > mMedium.mIndexHi[a]) return;
+            continue;
+        }
+        double inv = 1.0 / dir[a];
+        double ta = (mMedium.mIndexLo[a] - eye[a]) * inv, tb = (mMedium.mIndexHi[a] - eye[a]) * inv;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        if (t0 >= t1) return;
+    }
+    // Nudge exactly-zero components so the DDA's 1/dir stays finite.
+    for (int a = 0; a < 3; ++a)
+        if (dir[a] == 0) dir[a] = 1e-30;
+    VdbRay ray(eye, dir, t0, t1);
+    mHdda.hits(ray, mTopology, mSpans);
+    for (const auto& s : mSpans) {
+        float a = float(std::max(s.t0, t0)), b = float(std::min(s.t1, t1));
+        if (b > a) {
+            if (!out.empty() && a <= out.back().t1) out.back().t1 = std::max(out.back().t1, b);
+            else out.push_back({a, b});
+        }
+    }
+}
+
+}  // namespace
+
+// Picks the grid by name; with an empty name prefers "density", else the first
+// scalar grid. Reads it and returns it as a float grid.
+openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string& wanted, std::string* chosenName) {
+    auto file = openVdbFile(path);
+    std::string name = wanted;
+    if (name.empty()) {
+        auto grids = file->readAllGridMetadata();
+        for (const auto& g : *grids)
+            if (g->getName() == "density") name = "density";
+        if (name.empty())
+            for (const auto& g : *grids)
+                if (g->isType<openvdb::FloatGrid>() || g->isType<openvdb::DoubleGrid>()) {
+                    name = g->getName();
+                    break;
+                }
+        if (name.empty()) throw InputError(str(path, ": no float grid in the file; grids: ", gridListing(*file)));
+    }
+    if (!file->hasGrid(name))
+        throw InputError(str(path, ": no grid named '", name, "'; grids in the file: ", gridListing(*file)));
+    openvdb::GridBase::Ptr base;
+    try {
+        base = file->readGrid(name);
+    } catch (const std::exception& e) {
+        throw InputError(str(path, ": grid '", name, "' could not be read (", e.what(), ")"));
+    }
+    if (chosenName) *chosenName = name;
+    if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) return f;
+    if (auto d = openvdb::gridPtrCast<openvdb::DoubleGrid>(base)) {
+        auto f = openvdb::FloatGrid::create(float(d->background()));
+        f->setTransform(d->transform().copy());
+        f->setName(d->getName());
+        f->tree().topologyUnion(d->tree());
+        auto acc = f->getAccessor();
+        for (auto it = d->cbeginValueOn(); it; ++it) {
+            if (it.isVoxelValue()) acc.setValue(it.getCoord(), float(*it));
+            else f->tree().fill(it.getBoundingBox(), float(*it), true);
+        }
+        return f;
+    }
+    throw InputError(str(path, ": grid '", name, "' is a ", gridTypeName(*base),
+                         " grid; a scalar float grid is needed (density or emission)"));
+}
+
+std::unique_ptr<Medium> loadVdbMedium(const MediumDesc& desc) { return std::make_unique<VdbMedium>(desc); }
+
+VdbGridSummary summarizeVdb(const std::string& file, const std::string& grid) {
+    VdbGridSummary s;
+    auto g = readFloatGrid(file, grid, &s.gridName);
+    sanitize(*g, str(file, ": grid '", s.gridName, "'"));
+    Mat4 i2w = indexToWorldMatrix(*g, Mat4::identity(), file);
+    s.voxelSize = Infinity;
+    for (int c = 0; c < 3; ++c)
+        s.voxelSize = std::min(s.voxelSize, float(std::sqrt(i2w.m[0][c] * i2w.m[0][c] + i2w.m[1][c] * i2w.m[1][c] +
+                                                            i2w.m[2][c] * i2w.m[2][c])));
+    s.activeVoxels = g->activeVoxelCount();
+    double sum = 0;
+    size_t n = 0;
+    bool any = false;
+    for (auto it = g->cbeginValueOn(); it; ++it) {
+        float v = *it;
+        if (!any) s.minValue = s.maxValue = v;
+        any = true;
+        s.minValue = std::min(s.minValue, v);
+        s.maxValue = std::max(s.maxValue, v);
+        double count = double(it.getVoxelCount());
+        sum += double(v) * count;
+        n += size_t(count);
+    }
+    s.meanValue = n ? float(sum / double(n)) : 0.f;
+    openvdb::CoordBBox ib = g->evalActiveVoxelBoundingBox();
+    if (!ib.empty())
+        for (int i = 0; i < 8; ++i) {
+            openvdb::Vec3d c(i & 1 ? ib.max().x() + 0.5 : ib.min().x() - 0.5, i & 2 ? ib.max().y() + 0.5 : ib.min().y() - 0.5,
+                             i & 4 ? ib.max().z() + 0.5 : ib.min().z() - 0.5);
+            openvdb::Vec3d w = g->transform().indexToWorld(c);
+            s.worldBounds.expand(Vec3(float(w.x()), float(w.y()), float(w.z())));
+        }
+    return s;
+}
+
+std::vector<std::string> listVdbGrids(const std::string& path) {
+    auto file = openVdbFile(path);
+    std::vector<std::string> out;
+    auto grids = file->readAllGridMetadata();
+    for (const auto& g : *grids) out.push_back(str(g->getName(), " (", gridTypeName(*g), ")"));
+    return out;
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,373 @@
+#include "image/atomic_file.h"
+#include "image/exr_io.h"
+#include "image/image.h"
+#include "image/metrics.h"
+#include "image/png_io.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace vdbmarch;
+
+namespace {
+
+class ImageIoTest : public testing::Test {
+protected:
+    void SetUp() override {
+        std::string pattern = (fs::path(testing::TempDir()) / "vdbmarch_image_XXXXXX").string();
+        std::vector<char> buf(pattern.begin(), pattern.end());
+        buf.push_back('\0');
+        ASSERT_NE(mkdtemp(buf.data()), nullptr) << std::strerror(errno);
+        mDir = buf.data();
+    }
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(mDir, ec);
+    }
+
+    std::string path(const std::string& name) const { return (fs::path(mDir) / name).string(); }
+
+    std::vector<std::string> listDir() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(mDir)) names.push_back(e.path().filename().string());
+        return names;
+    }
+
+    static void writeText(const std::string& p, const std::string& text) {
+        std::ofstream(p, std::ios::binary) << text;
+    }
+    static std::string readText(const std::string& p) {
+        std::ifstream in(p, std::ios::binary);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    }
+
+    std::string mDir;
+};
+
+// Values that stress float exactness: denormals, huge, negative, non-finite.
+Image makeTestImage(int w, int h) {
+    Image img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            img.set(x, y, Color(x * 0.1f + 1e-3f, y * 1.7e5f, -0.3f * x * y),
+                    (x + y) % 2 ? 1.f : 0.25f);
+    img.set(0, 0, Color(std::numeric_limits<float>::denorm_min(), 3.4e38f, -0.f), 0.5f);
+    img.set(1, 0, Color(std::numeric_limits<float>::infinity(), 1.f / 3.f, 1e-30f), 1.f);
+    return img;
+}
+
+bool bitEqual(float a, float b) { return std::memcmp(&a, &b, sizeof(float)) == 0; }
+
+}  // namespace
+
+TEST(Image, StoresPixelsRowMajorTopFirst) {
+    Image img(3, 2);
+    ASSERT_EQ(img.rgba.size(), 24u);
+    EXPECT_EQ(img.rgb(2, 1), Color(0.f));
+    EXPECT_EQ(img.alpha(2, 1), 0.f);
+    img.set(2, 1, Color(1, 2, 3), 0.5f);
+    EXPECT_EQ(img.rgb(2, 1), Color(1, 2, 3));
+    EXPECT_EQ(img.alpha(2, 1), 0.5f);
+    // Last pixel of the second row is the last 4 floats.
+    EXPECT_EQ(img.rgba[20], 1.f);
+    EXPECT_EQ(img.rgba[23], 0.5f);
+    EXPECT_THROW(Image(-1, 2), InputError);
+}
+
+TEST_F(ImageIoTest, ExrRoundTripIsBitExactWithAttributes) {
+    Image img = makeTestImage(7, 5);
+    img.rgba[4 * 3 + 1] = std::numeric_limits<float>::quiet_NaN();
+    StringAttributes attrs = {{"vdbmarch/scene", "clouds.json"}, {"vdbmarch/spp", "256"},
+                              {"empty", ""}, {"utf8", "\xC3\xA9t\xC3\xA9 \"quoted\"\nnewline"}};
+    writeExr(path("a.exr"), img, attrs);
+
+    Image back = readExr(path("a.exr"));
+    ASSERT_EQ(back.width, 7);
+    ASSERT_EQ(back.height, 5);
+    ASSERT_EQ(back.rgba.size(), img.rgba.size());
+    for (size_t i = 0; i < img.rgba.size(); ++i)
+        EXPECT_TRUE(bitEqual(back.rgba[i], img.rgba[i])) << "float " << i << ": " << back.rgba[i]
+                                                         << " vs " << img.rgba[i];
+
+    StringAttributes read = readExrStringAttributes(path("a.exr"));
+    std::sort(attrs.begin(), attrs.end());
+    EXPECT_EQ(read, attrs);  // sorted by name, and no other string attributes
+    EXPECT_EQ(listDir(), std::vector<std::string>{"a.exr"});  // no temp file left
+}
+
+TEST_F(ImageIoTest, ExrWriteReplacesExistingFile) {
+    writeExr(path("a.exr"), makeTestImage(4, 4), {});
+    Image second(2, 3);
+    second.set(1, 2, Color(5, 6, 7), 1.f);
+    writeExr(path("a.exr"), second, {});
+    Image back = readExr(path("a.exr"));
+    EXPECT_EQ(back.width, 2);
+    EXPECT_EQ(back.height, 3);
+    EXPECT_EQ(back.rgb(1, 2), Color(5, 6, 7));
+}
+
+TEST_F(ImageIoTest, ReadExrMissingFileNamesIt) {
+    std::string p = path("missing.exr");
+    try {
+        readExr(p);
+        FAIL() << "expected IoError";
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(readExrStringAttributes(p), IoError);
+}
+
+TEST_F(ImageIoTest, ReadExrOfNonExrFileNamesIt) {
+    std::string p = path("text.exr");
+    writeText(p, "this is not an OpenEXR file\n");
+    try {
+        readExr(p);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(ImageIoTest, ReadExrOfTruncatedFileThrowsInputError) {
+    writeExr(path("a.exr"), makeTestImage(64, 64), {});
+    std::string bytes = readText(path("a.exr"));
+    writeText(path("cut.exr"), bytes.substr(0, bytes.size() / 2));
+    try {
+        readExr(path("cut.exr"));
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(path("cut.exr")), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(ImageIoTest, ExrRejectsReservedAttributeWithoutTouchingExistingFile) {
+    writeText(path("keep.exr"), "old contents");
+    EXPECT_THROW(writeExr(path("keep.exr"), makeTestImage(2, 2), {{"compression", "none"}}), InputError);
+    EXPECT_THROW(writeExr(path("keep.exr"), makeTestImage(2, 2), {{"a", "1"}, {"a", "2"}}), InputError);
+    EXPECT_THROW(writeExr(path("keep.exr"), Image(), {}), InputError);
+    EXPECT_EQ(readText(path("keep.exr")), "old contents");
+    EXPECT_EQ(listDir(), std::vector<std::string>{"keep.exr"});
+}
+
+TEST_F(ImageIoTest, WriteIntoMissingDirectoryThrowsIoError) {
+    std::string p = path("no/such/dir/a.exr");
+    try {
+        writeExr(p, makeTestImage(2, 2), {});
+        FAIL() << "expected IoError";
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(writePng(path("no/such/dir/a.png"), makeTestImage(2, 2)), IoError);
+}
+
+TEST_F(ImageIoTest, UncommittedAtomicFileLeavesNoFile) {
+    std::string tmp;
+    {
+        AtomicFile file(path("out.exr"));
+        tmp = file.tempPath();
+        EXPECT_EQ(fs::path(tmp).parent_path(), fs::path(mDir));
+        EXPECT_NE(tmp, path("out.exr"));
+        writeText(tmp, "partial");
+        ASSERT_TRUE(fs::exists(tmp));
+    }
+    EXPECT_FALSE(fs::exists(tmp));
+    EXPECT_FALSE(fs::exists(path("out.exr")));
+    EXPECT_TRUE(listDir().empty());
+}
+
+TEST_F(ImageIoTest, UncommittedAtomicFileDoesNotClobberExisting) {
+    writeText(path("out.txt"), "old");
+    {
+        AtomicFile file(path("out.txt"));
+        writeText(file.tempPath(), "new");
+    }
+    EXPECT_EQ(readText(path("out.txt")), "old");
+    EXPECT_EQ(listDir(), std::vector<std::string>{"out.txt"});
+}
+
+TEST_F(ImageIoTest, CommittedAtomicFileReplacesExisting) {
+    writeText(path("out.txt"), "old");
+    AtomicFile a(path("out.txt")), b(path("out.txt"));
+    EXPECT_NE(a.tempPath(), b.tempPath());  // concurrent writers do not collide
+    writeText(a.tempPath(), "new");
+    a.commit();
+    EXPECT_EQ(readText(path("out.txt")), "new");
+    EXPECT_FALSE(fs::exists(a.tempPath()));
+}
+
+TEST_F(ImageIoTest, CommitWithoutTempFileThrowsNamingPath) {
+    AtomicFile file(path("never.txt"));
+    try {
+        file.commit();
+        FAIL() << "expected IoError";
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find(path("never.txt")), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(path("never.txt")));
+}
+
+TEST_F(ImageIoTest, CheckWritable) {
+    EXPECT_NO_THROW(checkWritable(path("new.exr")));
+    writeText(path("existing.exr"), "x");
+    EXPECT_NO_THROW(checkWritable(path("existing.exr")));
+    EXPECT_THROW(checkWritable(path("missing/new.exr")), IoError);
+    EXPECT_THROW(checkWritable(path("existing.exr/new.exr")), IoError);  // parent is a file
+    fs::create_directory(path("sub"));
+    EXPECT_THROW(checkWritable(path("sub")), IoError);  // target is a directory
+    try {
+        checkWritable(path("missing/new.exr"));
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find(path("missing/new.exr")), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(ImageIoTest, PngRoundTripWithinQuantisation) {
+    Image img(16, 8);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 16; ++x)
+            img.set(x, y, Color(x / 15.f, y / 7.f, (x * y) / 105.f * 0.01f), 1.f);
+    writePng(path("a.png"), img);
+    Image back = readPng(path("a.png"));
+    ASSERT_EQ(back.width, 16);
+    ASSERT_EQ(back.height, 8);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 16; ++x)
+            for (int c = 0; c < 3; ++c) {
+                // Quantisation happens in the encoded domain: half a code value.
+                float want = linearToSrgb(img.rgb(x, y)[c]), got = linearToSrgb(back.rgb(x, y)[c]);
+                EXPECT_NEAR(got, want, 0.5f / 255.f + 1e-5f) << x << "," << y << "," << c;
+            }
+    EXPECT_EQ(back.alpha(3, 3), 1.f);
+    EXPECT_EQ(listDir(), std::vector<std::string>{"a.png"});
+}
+
+TEST_F(ImageIoTest, PngExposureClampAndNonFinite) {
+    Image img(5, 1);
+    img.set(0, 0, Color(0.25f), 1.f);
+    img.set(1, 0, Color(std::nanf(""), std::numeric_limits<float>::infinity(), -1.f), 1.f);
+    img.set(2, 0, Color(100.f), 1.f);
+    img.set(3, 0, Color(0.f), 1.f);
+    img.set(4, 0, Color(-std::numeric_limits<float>::infinity()), 1.f);
+    writePng(path("e.png"), img, 2.f);  // x4: 0.25 -> 1.0
+    Image back = readPng(path("e.png"));
+    EXPECT_EQ(back.rgb(0, 0), Color(1.f));
+    EXPECT_EQ(back.rgb(1, 0), Color(0.f));
+    EXPECT_EQ(back.rgb(2, 0), Color(1.f));
+    EXPECT_EQ(back.rgb(3, 0), Color(0.f));
+    EXPECT_EQ(back.rgb(4, 0), Color(0.f));
+    EXPECT_THROW(writePng(path("f.png"), img, std::nanf("")), InputError);
+}
+
+TEST_F(ImageIoTest, ReadPngErrors) {
+    EXPECT_THROW(readPng(path("missing.png")), IoError);
+    writeText(path("bad.png"), "not a png");
+    try {
+        readPng(path("bad.png"));
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(path("bad.png")), std::string::npos) << e.what();
+    }
+}
+
+TEST(SrgbCurve, InverseAndEndpoints) {
+    EXPECT_FLOAT_EQ(linearToSrgb(0.f), 0.f);
+    EXPECT_FLOAT_EQ(linearToSrgb(1.f), 1.f);
+    EXPECT_NEAR(linearToSrgb(0.18f), 0.4613f, 1e-4f);  // middle grey
+    for (float v = 0; v <= 1.f; v += 1.f / 64)
+        EXPECT_NEAR(srgbToLinear(linearToSrgb(v)), v, 1e-6f);
+}
+
+TEST(Metrics, IdenticalImagesGiveZero) {
+    Image a = makeTestImage(6, 4);
+    ImageErrorStats s = compareImages(a, a);
+    EXPECT_EQ(s.rmse, 0.0);
+    EXPECT_EQ(s.relMse, 0.0);
+    EXPECT_EQ(s.meanAbsRelError, 0.0);
+    EXPECT_EQ(s.nonFiniteA, 1u);  // makeTestImage has one inf pixel
+    EXPECT_EQ(s.nonFiniteB, 1u);
+    EXPECT_EQ(s.pixels, 23u);
+    EXPECT_EQ(s.meanA, s.meanB);
+}
+
+TEST(Metrics, ConstantOffsetGivesExactErrors) {
+    Image ref(4, 3), test(4, 3);
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x) {
+            ref.set(x, y, Color(0.5f), 1.f);
+            test.set(x, y, Color(0.75f), 0.f);  // alpha differs: must be ignored
+        }
+    ImageErrorStats s = compareImages(test, ref);
+    EXPECT_EQ(s.rmse, 0.25);  // every term is dyadic, so the sum is exact
+    // These terms are not exactly representable: allow summation rounding.
+    EXPECT_NEAR(s.relMse, 0.0625 / (0.25 + 0.01), 1e-14);
+    EXPECT_NEAR(s.meanAbsRelError, 0.25 / (0.5 + 0.01), 1e-14);
+    EXPECT_DOUBLE_EQ(s.meanA, 0.75);
+    EXPECT_DOUBLE_EQ(s.meanB, 0.5);
+    EXPECT_EQ(s.pixels, 12u);
+    EXPECT_EQ(s.nonFiniteA + s.nonFiniteB, 0u);
+}
+
+TEST(Metrics, SizeMismatchThrowsWithBothSizes) {
+    try {
+        compareImages(Image(4, 3), Image(3, 4));
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        std::string msg = e.what();
+        EXPECT_NE(msg.find("4x3"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("3x4"), std::string::npos) << msg;
+    }
+}
+
+TEST(Metrics, NonFinitePixelsAreCountedAndExcluded) {
+    Image ref(3, 1), test(3, 1);
+    for (int x = 0; x < 3; ++x) {
+        ref.set(x, 0, Color(1.f), 1.f);
+        test.set(x, 0, Color(2.f), 1.f);
+    }
+    test.set(0, 0, Color(1.f, std::nanf(""), 1.f), 1.f);
+    ref.set(1, 0, Color(std::numeric_limits<float>::infinity(), 1.f, 1.f), 1.f);
+    test.set(1, 0, Color(std::nanf(""), 1.f, 1.f), 1.f);
+    ImageErrorStats s = compareImages(test, ref);
+    EXPECT_EQ(s.nonFiniteA, 2u);
+    EXPECT_EQ(s.nonFiniteB, 1u);
+    EXPECT_EQ(s.pixels, 1u);
+    EXPECT_DOUBLE_EQ(s.rmse, 1.0);  // only pixel 2 (offset 1) remains
+    EXPECT_TRUE(std::isfinite(s.relMse));
+
+    // Nothing left to compare: the means are undefined, not zero.
+    Image allNan(1, 1);
+    allNan.set(0, 0, Color(std::nanf("")), 1.f);
+    EXPECT_TRUE(std::isnan(compareImages(allNan, Image(1, 1)).rmse));
+}
+
+TEST_F(ImageIoTest, FalseColorDiff) {
+    Image ref(101, 1), test(101, 1);
+    for (int x = 0; x < 101; ++x) test.set(x, 0, Color(x / 100.f), 1.f);
+    test.set(50, 0, Color(std::nanf("")), 1.f);
+    writeFalseColorDiff(path("diff.png"), test, ref);
+    Image back = readPng(path("diff.png"));
+    ASSERT_EQ(back.width, 101);
+    auto bytes = [&](int x) {
+        Color c = back.rgb(x, 0);
+        return std::vector<long>{std::lround(linearToSrgb(c.x) * 255), std::lround(linearToSrgb(c.y) * 255),
+                                 std::lround(linearToSrgb(c.z) * 255)};
+    };
+    EXPECT_EQ(bytes(0), (std::vector<long>{0x44, 0x01, 0x54}));   // no error: viridis start
+    EXPECT_EQ(bytes(100), (std::vector<long>{0xFD, 0xE7, 0x25})); // at/above p99: viridis end
+    EXPECT_EQ(bytes(99), (std::vector<long>{0xFD, 0xE7, 0x25}));
+    EXPECT_EQ(bytes(50), (std::vector<long>{255, 0, 255}));       // non-finite: magenta
+    EXPECT_NE(bytes(30), bytes(60));                              // monotone ramp is not flat
+    EXPECT_THROW(writeFalseColorDiff(path("x.png"), test, Image(2, 2)), InputError);
+}

@@ -1,0 +1,213 @@
+// The vdbmarch command: parse options, validate, run, catch. All errors from
+// the library arrive as exceptions and leave here as one line on stderr and a
+// non-zero exit code; outputs are written atomically, so a failed run leaves
+// nothing behind.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "image/atomic_file.h"
+#include "image/exr_io.h"
+#include "image/metrics.h"
+#include "image/png_io.h"
+#include "marchers/marcher.h"
+#include "render.h"
+#include "scene/auto_scene.h"
+#include "scene/scene.h"
+#include "volume/medium.h"
+
+using namespace vdbmarch;
+
+namespace {
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+    if (s.size() < suffix.size()) return false;
+    for (size_t i = 0; i < suffix.size(); ++i)
+        if (std::tolower(static_cast<unsigned char>(s[s.size() - suffix.size() + i])) != suffix[i]) return false;
+    return true;
+}
+
+struct RenderArgs {
+    std::string input, output, png, method, res, stats;
+    int spp = 0, threads = -1;
+    long long seed = -1;
+    double step = 0, exposure = 0;
+    bool exposureSet = false, quiet = false, noProgress = false;
+    std::vector<std::string> sets;
+};
+
+void writeTextAtomic(const std::string& path, const std::string& text) {
+    AtomicFile f(path);
+    {
+        std::ofstream out(f.tempPath(), std::ios::binary);
+        out << text;
+        if (!out) throw IoError(str(path, ": cannot write"));
+    }
+    f.commit();
+}
+
+int runRender(const RenderArgs& a) {
+    auto t0 = std::chrono::steady_clock::now();
+    if (!endsWith(a.output, ".exr"))
+        throw InputError(str("-o ", a.output, ": the output must be an .exr file"));
+    if (!a.png.empty() && !endsWith(a.png, ".png"))
+        throw InputError(str("--png ", a.png, ": the preview must be a .png file"));
+    if (!a.stats.empty() && !endsWith(a.stats, ".json"))
+        throw InputError(str("--stats ", a.stats, ": the statistics file must be a .json file"));
+    checkWritable(a.output);
+    if (!a.png.empty()) checkWritable(a.png);
+    if (!a.stats.empty()) checkWritable(a.stats);
+
+    // Command-line options are overrides of the scene document, so they are
+    // validated by the same parser and recorded in the output.
+    std::vector<std::string> overrides = a.sets;
+    if (!a.method.empty()) overrides.push_back("render.method=\"" + a.method + "\"");
+    if (a.spp > 0) overrides.push_back(str("render.spp=", a.spp));
+    else if (a.spp < 0 || (a.spp == 0 && false)) throw InputError(str("--spp ", a.spp, ": must be at least 1"));
+    if (a.seed >= 0) overrides.push_back(str("render.seed=", a.seed));
+    if (a.threads >= 0) overrides.push_back(str("render.threads=", a.threads));
+    if (a.step > 0) overrides.push_back(str("render.step=", a.step));
+    if (a.exposureSet) overrides.push_back(str("render.exposure=", a.exposure));
+    if (!a.res.empty()) {
+        int w = 0, h = 0;
+        char x = 0, extra = 0;
+        if (std::sscanf(a.res.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+            throw InputError(str("--res ", a.res, ": expected WIDTHxHEIGHT, e.g. 640x480"));
+        overrides.push_back(str("camera.resolution=[", w, ",", h, "]"));
+    }
+
+    SceneDesc desc = endsWith(a.input, ".vdb") ? loadAutoScene(a.input, overrides) : loadSceneFile(a.input, overrides);
+    std::unique_ptr<Scene> scene = buildScene(desc);
+    makeMarcher(desc.render.method, *scene);  // validate before any work
+    double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    RenderOptions options;
+    options.progress = !a.quiet && !a.noProgress && isatty(STDERR_FILENO);
+    RenderResult r = renderImage(*scene, options);
+    const RenderCounters& c = r.counters;
+    if (c.nonFiniteSamples > 0)
+        warn(str(c.nonFiniteSamples, " path sample(s) gave NaN or Inf and were dropped"));
+
+    StringAttributes attrs = {
+        {"vdbmarch:version", VDBMARCH_VERSION},
+        {"vdbmarch:source", desc.file},
+        {"vdbmarch:method", desc.render.method},
+        {"vdbmarch:spp", std::to_string(desc.render.spp)},
+        {"vdbmarch:seed", std::to_string(desc.render.seed)},
+        {"vdbmarch:step", str(scene->step)},
+        {"vdbmarch:shadowStep", str(scene->shadowStep)},
+        {"vdbmarch:renderSeconds", str(r.seconds)},
+        {"vdbmarch:scene", desc.json.dump()},
+    };
+    writeExr(a.output, r.image, attrs);
+    if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
+    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!a.stats.empty()) {
+        nlohmann::json s;
+        s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"total", total}};
+        s["threads"] = r.threads;
+        s["method"] = desc.render.method;
+        s["spp"] = desc.render.spp;
+        s["resolution"] = {r.image.width, r.image.height};
+        s["step"] = scene->step;
+        s["shadow_step"] = scene->shadowStep;
+        s["counters"] = {{"camera_rays", c.cameraRays},         {"surface_hits", c.surfaceHits},
+                         {"march_samples", c.marchSamples},     {"shadow_rays", c.shadowRays},
+                         {"shadow_samples", c.shadowSamples},   {"non_finite_samples", c.nonFiniteSamples},
+                         {"marched_length", c.marchedLength},   {"skipped_empty_length", c.skippedLength}};
+        writeTextAtomic(a.stats, s.dump(2) + "\n");
+    }
+    if (!a.quiet)
+        std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (load %.3f s, total %.3f s) -> %s%s%s\n",
+                     r.image.width, r.image.height, desc.render.spp, desc.render.method.c_str(), double(scene->step),
+                     r.seconds, loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
+    return 0;
+}
+
+int runCompare(const std::string& a, const std::string& b, const std::string& diff) {
+    if (!diff.empty()) checkWritable(diff);
+    Image ia = readExr(a), ib = readExr(b);
+    ImageErrorStats s = compareImages(ia, ib);
+    std::printf("rmse %.6g\nrelmse %.6g\nmean_abs_rel_error %.6g\nmean_test %.6g\nmean_reference %.6g\n"
+                "rmse_over_mean %.6g\nnonfinite_test %zu\nnonfinite_reference %zu\npixels %zu\n",
+                s.rmse, s.relMse, s.meanAbsRelError, s.meanA, s.meanB, s.meanB != 0 ? s.rmse / s.meanB : 0.0,
+                s.nonFiniteA, s.nonFiniteB, s.pixels);
+    if (!diff.empty()) writeFalseColorDiff(diff, ia, ib);
+    return 0;
+}
+
+int runInfo(const std::string& file) {
+    for (const auto& g : listVdbGrids(file)) std::printf("grid %s\n", g.c_str());
+    VdbGridSummary s = summarizeVdb(file, "");
+    std::printf("summary of '%s': %zu active voxels, voxel size %g, values [%g, %g] mean %g\n"
+                "world bounds [%g %g %g] - [%g %g %g]\n",
+                s.gridName.c_str(), s.activeVoxels, double(s.voxelSize), double(s.minValue), double(s.maxValue),
+                double(s.meanValue), double(s.worldBounds.lo.x), double(s.worldBounds.lo.y), double(s.worldBounds.lo.z),
+                double(s.worldBounds.hi.x), double(s.worldBounds.hi.y), double(s.worldBounds.hi.z));
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"vdbmarch: physically based ray marching of OpenVDB smoke, clouds and fog"};
+    app.set_version_flag("--version", std::string("vdbmarch ") + VDBMARCH_VERSION);
+    app.require_subcommand(1);
+
+    RenderArgs ra;
+    std::string methods;
+    for (const auto& m : marcherNames()) methods += (methods.empty() ? "" : ", ") + m;
+    CLI::App* render = app.add_subcommand("render", "Render a JSON scene or a bare .vdb file to EXR (and PNG)");
+    render->add_option("input", ra.input, "Scene .json, or a .vdb to render with automatic camera and lights")->required();
+    render->add_option("-o,--output", ra.output, "Output image (.exr, float RGBA, alpha = 1 - transmittance)")->required();
+    render->add_option("--png", ra.png, "Also write an sRGB PNG preview");
+    render->add_option("--method", ra.method, "Estimator: " + methods);
+    render->add_option("--spp", ra.spp, "Samples per pixel")->check(CLI::PositiveNumber);
+    render->add_option("--res", ra.res, "Resolution WIDTHxHEIGHT");
+    render->add_option("--seed", ra.seed, "Random seed")->check(CLI::NonNegativeNumber);
+    render->add_option("--threads", ra.threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+    render->add_option("--step", ra.step, "March step in world units (default: one voxel)")->check(CLI::PositiveNumber);
+    render->add_option("--exposure", ra.exposure, "PNG exposure in stops")->each([&](const std::string&) { ra.exposureSet = true; });
+    render->add_option("--set", ra.sets, "Override a scene key: key.path=value (JSON value), repeatable");
+    render->add_option("--stats", ra.stats, "Write timings and counters as JSON");
+    render->add_flag("-q,--quiet", ra.quiet, "No progress bar or summary line");
+    render->add_flag("--no-progress", ra.noProgress, "No progress bar");
+
+    std::string ca, cb, cdiff;
+    CLI::App* compare = app.add_subcommand("compare", "Error metrics of a test image against a reference (EXR)");
+    compare->add_option("test", ca, "Test image (.exr)")->required();
+    compare->add_option("reference", cb, "Reference image (.exr)")->required();
+    compare->add_option("--diff", cdiff, "Write a false-colour difference PNG");
+
+    std::string infoFile;
+    CLI::App* info = app.add_subcommand("info", "List the grids of a .vdb file and summarise its density grid");
+    info->add_option("file", infoFile, "VDB file")->required();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    try {
+        if (*render) return runRender(ra);
+        if (*compare) return runCompare(ca, cb, cdiff);
+        if (*info) return runInfo(infoFile);
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "vdbmarch: error: %s\n", e.what());
+        return 1;
+    } catch (const IoError& e) {
+        std::fprintf(stderr, "vdbmarch: error: %s\n", e.what());
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "vdbmarch: internal error: %s\n", e.what());
+        return 3;
+    }
+    return 0;
+}
