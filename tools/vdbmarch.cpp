@@ -35,7 +35,7 @@ bool endsWith(const std::string& s, const std::string& suffix) {
 }
 
 struct RenderArgs {
-    std::string input, output, png, method, res, stats;
+    std::string input, output, png, method, res, stats, saveScene;
     int spp = 0, threads = -1;
     long long seed = -1;
     double step = 0, exposure = 0;
@@ -64,6 +64,7 @@ int runRender(const RenderArgs& a) {
     checkWritable(a.output);
     if (!a.png.empty()) checkWritable(a.png);
     if (!a.stats.empty()) checkWritable(a.stats);
+    if (!a.saveScene.empty()) checkWritable(a.saveScene);
 
     // Command-line options are overrides of the scene document, so they are
     // validated by the same parser and recorded in the output.
@@ -84,6 +85,7 @@ int runRender(const RenderArgs& a) {
     }
 
     SceneDesc desc = endsWith(a.input, ".vdb") ? loadAutoScene(a.input, overrides) : loadSceneFile(a.input, overrides);
+    if (!a.saveScene.empty()) writeTextAtomic(a.saveScene, desc.json.dump(2) + "\n");
     std::unique_ptr<Scene> scene = buildScene(desc);
     makeMarcher(desc.render.method, *scene);  // validate before any work
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -177,6 +179,8 @@ int main(int argc, char** argv) {
     render->add_option("--exposure", ra.exposure, "PNG exposure in stops")->each([&](const std::string&) { ra.exposureSet = true; });
     render->add_option("--set", ra.sets, "Override a scene key: key.path=value (JSON value), repeatable");
     render->add_option("--stats", ra.stats, "Write timings and counters as JSON");
+    render->add_option("--save-scene", ra.saveScene,
+                       "Write the effective scene (after --set and options; the generated one for a .vdb) as JSON");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or summary line");
     render->add_flag("--no-progress", ra.noProgress, "No progress bar");
 

@@ -87,27 +87,39 @@ int regionAtRayStart(const Scene& scene, const Ray& r) {
 
 namespace {
 
-// Optical depth of the region's media over [0, tEnd) of ray r, by uniform
-// steps at (k + u) * step: an unbiased estimate of the integral of sigma_t.
-// Stops early once every channel's depth exceeds `depthCutoff`.
+// Optical depth of the region's media over [0, tEnd) of ray r. Constant
+// media integrate exactly; gridded media are marched with uniform steps at
+// (k + u) * step, an unbiased estimate of the integral of sigma_t. Stops early
+// once every channel's depth exceeds `depthCutoff`.
 Color opticalDepth(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng, float depthCutoff) {
     Color tau(0);
     const auto& media = ctx.scene.regions[size_t(region)].media;
     if (media.empty()) return tau;
-    regionIntervals(ctx, region, r, 0.f, tEnd, ctx.shadowIntervals);
-    if (ctx.shadowIntervals.empty()) return tau;
-    if (!std::isfinite(ctx.shadowIntervals.back().t1)) return Color(Infinity);  // unbounded fog
     const float step = ctx.scene.shadowStep;
     const float u = rng.uniform();
-    MediumPoint mp;
-    for (const Interval& iv : ctx.shadowIntervals) {
-        float k = std::ceil(iv.t0 / step - u);
-        for (float t = (k + u) * step; t < iv.t1; k += 1, t = (k + u) * step) {
-            evalMedia(ctx, region, r.at(t), mp);
-            ++ctx.counters.shadowSamples;
-            tau += mp.sigma_t * step;
+    for (int mi : media) {
+        MediumQuery& q = *ctx.queries[size_t(mi)];
+        const Medium& m = *ctx.scene.media[size_t(mi)];
+        const Color sigmaT = m.sigma_a + m.sigma_s;
+        float integral;
+        if (q.densityIntegral(r, 0.f, tEnd, integral)) {
+            for (int c = 0; c < 3; ++c)  // unbounded fog: inf * 0 must not make NaN
+                if (integral > 0 && sigmaT[c] > 0) tau[c] += sigmaT[c] * integral;
             if (minComponent(tau) > depthCutoff) return tau;
+            continue;
         }
+        ctx.shadowIntervals.clear();
+        q.activeIntervals(r, 0.f, tEnd, ctx.shadowIntervals);
+        float sum = 0;
+        for (const Interval& iv : ctx.shadowIntervals) {
+            float k = std::ceil(iv.t0 / step - u);
+            for (float t = (k + u) * step; t < iv.t1; k += 1, t = (k + u) * step) {
+                sum += q.density(r.at(t));
+                ++ctx.counters.shadowSamples;
+                if (minComponent(tau + sigmaT * (sum * step)) > depthCutoff) return tau + sigmaT * (sum * step);
+            }
+        }
+        tau += sigmaT * (sum * step);
     }
     return tau;
 }

@@ -1,7 +1,7 @@
 // A complete scene for a bare .vdb file: the camera frames the grid's world
 // bounds, a sun-like directional light and a constant sky light it, and the
 // coefficients are chosen from the grid's density range and size so that any
-// asset reads as a cloud (optical depth ~8 across its typical chord).
+// asset reads as a cloud (optical depth ~6 across its typical chord).
 #pragma once
 
 #include <string>

@@ -19,6 +19,13 @@ public:
         if (mBounds.intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1});
     }
 
+    bool densityIntegral(const Ray& r, float tMin, float tMax, float& integral) override {
+        integral = 0;
+        float t0 = tMin, t1 = tMax;
+        if (!mBounded || (mBounds.intersect(r, t0, t1) && t1 > t0)) integral = t1 - t0;
+        return true;
+    }
+
 private:
     bool mBounded;
     BBox mBounds;

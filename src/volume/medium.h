@@ -24,6 +24,10 @@ public:
     // density may be non-zero, in increasing order. Everything outside them is
     // empty space that the marchers skip.
     virtual void activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) = 0;
+    // Media of constant density integrate exactly: sets the integral of the
+    // density over [tMin, tMax] and returns true. Gridded media return false
+    // and are marched.
+    virtual bool densityIntegral(const Ray& r, float tMin, float tMax, float& integral) { return false; }
 };
 
 class Medium {

@@ -11,6 +11,10 @@
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/tools/Morphology.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 
 #include "core/error.h"
 #include "core/transform.h"
@@ -152,6 +156,59 @@ inline float sampleTrilinear(openvdb::FloatGrid::ConstAccessor& acc, const openv
     return b0 + (b1 - b0) * tx;
 }
 
+// Density copied into padded 9x9x9 blocks, one per 8x8x8 leaf-aligned block
+// where samples can land: every trilinear lookup then reads its eight corners
+// from one contiguous block, with no tree traversal while a ray stays inside
+// the block (a step of one voxel stays ~8 samples in a block).
+struct PaddedBlocks {
+    static constexpr int N = 9, Size = N * N * N;
+    std::vector<float> values;   // Size floats per block
+    openvdb::Int32Tree index{0};  // at each block origin: block id + 1; 0 = empty
+
+    void build(const openvdb::FloatGrid& grid, const BoolTree& topology) {
+        std::vector<openvdb::Coord> origins;
+        for (auto leaf = topology.cbeginLeaf(); leaf; ++leaf) origins.push_back(leaf->origin());
+        // Active tiles of the topology (coarse constant regions) hold blocks too.
+        for (auto it = topology.cbeginValueOn(); it; ++it) {
+            if (it.isVoxelValue()) continue;
+            openvdb::CoordBBox b = it.getBoundingBox();
+            for (int x = b.min().x(); x <= b.max().x(); x += 8)
+                for (int y = b.min().y(); y <= b.max().y(); y += 8)
+                    for (int z = b.min().z(); z <= b.max().z(); z += 8) origins.emplace_back(x, y, z);
+        }
+        std::sort(origins.begin(), origins.end());
+        origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+        values.assign(origins.size() * Size, 0.f);
+        std::vector<char> nonEmpty(origins.size(), 0);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+            auto acc = grid.getConstAccessor();
+            for (size_t b = r.begin(); b != r.end(); ++b) {
+                float* dst = &values[b * Size];
+                const openvdb::Coord o = origins[b];
+                bool any = false;
+                for (int x = 0; x < N; ++x)
+                    for (int y = 0; y < N; ++y)
+                        for (int z = 0; z < N; ++z) {
+                            float v = acc.getValue(o.offsetBy(x, y, z));
+                            dst[(x * N + y) * N + z] = v;
+                            any = any || v != 0;
+                        }
+                nonEmpty[b] = any;
+            }
+        });
+        // Compact: drop all-zero blocks.
+        size_t kept = 0;
+        for (size_t b = 0; b < origins.size(); ++b) {
+            if (!nonEmpty[b]) continue;
+            if (kept != b) std::copy_n(&values[b * Size], Size, &values[kept * Size]);
+            index.setValue(origins[b], int32_t(kept + 1));
+            ++kept;
+        }
+        values.resize(kept * Size);
+        values.shrink_to_fit();
+    }
+};
+
 class VdbMedium;
 
 class VdbQuery final : public MediumQuery {
@@ -166,6 +223,9 @@ private:
     openvdb::FloatGrid::ConstAccessor mDensity;
     std::unique_ptr<openvdb::FloatGrid::ConstAccessor> mEmission;
     openvdb::tree::ValueAccessor<const BoolTree> mTopology;
+    openvdb::tree::ValueAccessor<const openvdb::Int32Tree> mBlockIndex;
+    const float* mBlock = nullptr;            // cached block for mBlockOrigin
+    openvdb::Coord mBlockOrigin{INT32_MIN, 0, 0};
     openvdb::math::VolumeHDDA<BoolTree, VdbRay, 0> mHdda;
     std::vector<VdbRay::TimeSpan> mSpans;
 };
@@ -213,6 +273,7 @@ public:
         mTopology->evalActiveVoxelBoundingBox(ib);
         mIndexLo = openvdb::Vec3d(ib.min().x(), ib.min().y(), ib.min().z());
         mIndexHi = openvdb::Vec3d(ib.max().x() + 1, ib.max().y() + 1, ib.max().z() + 1);
+        if (mMaxDensity > 0) mBlocks.build(*mDensity, *mTopology);
         if (mMaxDensity > 0)
             for (int i = 0; i < 8; ++i) {
                 Vec3 corner(float(i & 1 ? mIndexHi.x() : mIndexLo.x()), float(i & 2 ? mIndexHi.y() : mIndexLo.y()),
@@ -243,6 +304,7 @@ private:
     friend class VdbQuery;
     openvdb::FloatGrid::Ptr mDensity, mEmissionGrid;
     std::unique_ptr<BoolTree> mTopology;
+    PaddedBlocks mBlocks;
     Affine mW2I, mEmissionW2I;
     openvdb::Vec3d mIndexLo, mIndexHi;
     BBox mWorldBounds;
@@ -251,12 +313,29 @@ private:
 };
 
 VdbQuery::VdbQuery(const VdbMedium& m)
-    : mMedium(m), mDensity(m.mDensity->getConstAccessor()), mTopology(*m.mTopology) {
+    : mMedium(m), mDensity(m.mDensity->getConstAccessor()), mTopology(*m.mTopology), mBlockIndex(m.mBlocks.index) {
     if (m.mEmissionGrid) mEmission = std::make_unique<openvdb::FloatGrid::ConstAccessor>(m.mEmissionGrid->getConstAccessor());
 }
 
 float VdbQuery::density(const Vec3& p) {
-    return sampleTrilinear(mDensity, mMedium.mW2I.point(p)) * mMedium.mScale;
+    const openvdb::Vec3d q = mMedium.mW2I.point(p);
+    const double fx = std::floor(q.x()), fy = std::floor(q.y()), fz = std::floor(q.z());
+    const int ix = int(fx), iy = int(fy), iz = int(fz);
+    const openvdb::Coord origin(ix & ~7, iy & ~7, iz & ~7);
+    if (origin != mBlockOrigin) {
+        mBlockOrigin = origin;
+        int32_t id = mBlockIndex.getValue(origin);
+        mBlock = id > 0 ? &mMedium.mBlocks.values[size_t(id - 1) * PaddedBlocks::Size] : nullptr;
+    }
+    if (!mBlock) return 0.f;
+    const float tx = float(q.x() - fx), ty = float(q.y() - fy), tz = float(q.z() - fz);
+    constexpr int N = PaddedBlocks::N;
+    const float* v = mBlock + ((ix & 7) * N + (iy & 7)) * N + (iz & 7);
+    // corners: +1 in z is +1, in y is +N, in x is +N*N
+    float a00 = v[0] + (v[1] - v[0]) * tz, a01 = v[N] + (v[N + 1] - v[N]) * tz;
+    float a10 = v[N * N] + (v[N * N + 1] - v[N * N]) * tz, a11 = v[N * N + N] + (v[N * N + N + 1] - v[N * N + N]) * tz;
+    float b0 = a00 + (a01 - a00) * ty, b1 = a10 + (a11 - a10) * ty;
+    return (b0 + (b1 - b0) * tx) * mMedium.mScale;
 }
 
 float VdbQuery::emission(const Vec3& p) {
