@@ -114,20 +114,24 @@ private:
                     float q = m / RouletteThreshold;
                     if (rng.uniform() >= q) {
                         beta = Color(0);
-                        addLengths(ctx, ray, tEnd, active);
+                        addLengths(ctx, tEnd, active);
                         return false;
                     }
                     beta /= q;
                 }
             }
         }
-        addLengths(ctx, ray, tEnd, active);
+        addLengths(ctx, tEnd, active);
         return true;
     }
 
-    static void addLengths(ThreadContext& ctx, const Ray&, float tEnd, double active) {
+    // Skipped = the part of [0, end) outside active intervals, where `end` is
+    // the segment end or, for rays to infinity, the end of the last interval.
+    static void addLengths(ThreadContext& ctx, float tEnd, double active) {
         ctx.counters.marchedLength += active;
-        if (std::isfinite(tEnd)) ctx.counters.skippedLength += std::max(0.0, double(tEnd) - active);
+        double end = std::isfinite(tEnd) ? double(tEnd)
+                                         : (ctx.intervals.empty() ? 0.0 : double(std::min(ctx.intervals.back().t1, 1e30f)));
+        ctx.counters.skippedLength += std::max(0.0, end - active);
     }
 
     const Scene& mScene;

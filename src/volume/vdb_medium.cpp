@@ -164,6 +164,29 @@ struct PaddedBlocks {
     static constexpr int N = 9, Size = N * N * N;
     std::vector<float> values;   // Size floats per block
     openvdb::Int32Tree index{0};  // at each block origin: block id + 1; 0 = empty
+    // Per block, the cells (0..7 per axis) whose trilinear stencil touches a
+    // non-zero value: lo in bits 0-11, hi (exclusive, 1..8) in bits 12-23.
+    std::vector<uint32_t> tightBox;
+
+    static uint32_t computeTightBox(const float* v) {
+        int lo[3] = {8, 8, 8}, hi[3] = {0, 0, 0};
+        for (int x = 0; x < 8; ++x)
+            for (int y = 0; y < 8; ++y)
+                for (int z = 0; z < 8; ++z) {
+                    bool nonZero = false;
+                    for (int c = 0; c < 8 && !nonZero; ++c)
+                        nonZero = v[((x + (c >> 2)) * N + y + ((c >> 1) & 1)) * N + z + (c & 1)] != 0;
+                    if (!nonZero) continue;
+                    int p[3] = {x, y, z};
+                    for (int a = 0; a < 3; ++a) {
+                        lo[a] = std::min(lo[a], p[a]);
+                        hi[a] = std::max(hi[a], p[a] + 1);
+                    }
+                }
+        uint32_t packed = 0;
+        for (int a = 0; a < 3; ++a) packed |= uint32_t(lo[a]) << (4 * a) | uint32_t(hi[a]) << (12 + 4 * a);
+        return packed;
+    }
 
     void build(const openvdb::FloatGrid& grid, const BoolTree& topology) {
         std::vector<openvdb::Coord> origins;
@@ -180,6 +203,7 @@ struct PaddedBlocks {
         origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
         values.assign(origins.size() * Size, 0.f);
         std::vector<char> nonEmpty(origins.size(), 0);
+        std::vector<uint32_t> boxes(origins.size(), 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
             auto acc = grid.getConstAccessor();
             for (size_t b = r.begin(); b != r.end(); ++b) {
@@ -194,6 +218,7 @@ struct PaddedBlocks {
                             any = any || v != 0;
                         }
                 nonEmpty[b] = any;
+                if (any) boxes[b] = computeTightBox(dst);
             }
         });
         // Compact: drop all-zero blocks.
@@ -202,6 +227,7 @@ struct PaddedBlocks {
             if (!nonEmpty[b]) continue;
             if (kept != b) std::copy_n(&values[b * Size], Size, &values[kept * Size]);
             index.setValue(origins[b], int32_t(kept + 1));
+            tightBox.push_back(boxes[b]);
             ++kept;
         }
         values.resize(kept * Size);
@@ -226,7 +252,8 @@ private:
     openvdb::tree::ValueAccessor<const openvdb::Int32Tree> mBlockIndex;
     const float* mBlock = nullptr;            // cached block for mBlockOrigin
     openvdb::Coord mBlockOrigin{INT32_MIN, 0, 0};
-    openvdb::math::VolumeHDDA<BoolTree, VdbRay, 0> mHdda;
+    // Starts at the root's children and descends: large empty nodes are skipped whole.
+    openvdb::math::VolumeHDDA<BoolTree, VdbRay, BoolTree::RootNodeType::ChildNodeType::LEVEL> mHdda;
     std::vector<VdbRay::TimeSpan> mSpans;
 };
 
@@ -317,10 +344,16 @@ VdbQuery::VdbQuery(const VdbMedium& m)
     if (m.mEmissionGrid) mEmission = std::make_unique<openvdb::FloatGrid::ConstAccessor>(m.mEmissionGrid->getConstAccessor());
 }
 
+// floor() without a libm call on baseline x86-64 (no SSE4.1 rounding).
+inline int fastFloor(double x) {
+    int i = int(x);
+    return i - (x < double(i));
+}
+
 float VdbQuery::density(const Vec3& p) {
     const openvdb::Vec3d q = mMedium.mW2I.point(p);
-    const double fx = std::floor(q.x()), fy = std::floor(q.y()), fz = std::floor(q.z());
-    const int ix = int(fx), iy = int(fy), iz = int(fz);
+    const int ix = fastFloor(q.x()), iy = fastFloor(q.y()), iz = fastFloor(q.z());
+    const double fx = ix, fy = iy, fz = iz;
     const openvdb::Coord origin(ix & ~7, iy & ~7, iz & ~7);
     if (origin != mBlockOrigin) {
         mBlockOrigin = origin;
@@ -366,11 +399,51 @@ void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector
         if (dir[a] == 0) dir[a] = 1e-30;
     VdbRay ray(eye, dir, t0, t1);
     mHdda.hits(ray, mTopology, mSpans);
-    for (const auto& s : mSpans) {
-        float a = float(std::max(s.t0, t0)), b = float(std::min(s.t1, t1));
-        if (b > a) {
-            if (!out.empty() && a <= out.back().t1) out.back().t1 = std::max(out.back().t1, b);
-            else out.push_back({a, b});
+    // The hierarchical DDA finds spans of leaf-sized blocks; within them walk
+    // the blocks with a 3D-DDA on the 8-voxel lattice and keep only the part
+    // of the ray inside each block's tight box of non-zero stencils.
+    const openvdb::Vec3d inv(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
+    auto emit = [&](double a, double b) {
+        float fa = float(a), fb = float(b);
+        if (!(fb > fa)) return;
+        if (!out.empty() && fa <= out.back().t1) out.back().t1 = std::max(out.back().t1, fb);
+        else out.push_back({fa, fb});
+    };
+    for (const auto& span : mSpans) {
+        double s0 = std::max(span.t0, t0), s1 = std::min(span.t1, t1);
+        if (!(s1 > s0)) continue;
+        // Block containing the span's midpoint start, then step block to block.
+        openvdb::Vec3d p = eye + dir * (s0 + 1e-9 * (s1 - s0));
+        int cell[3], step[3];
+        double tNext[3], tDelta[3];
+        for (int a = 0; a < 3; ++a) {
+            cell[a] = fastFloor(p[a]) & ~7;
+            step[a] = dir[a] > 0 ? 8 : -8;
+            double boundary = dir[a] > 0 ? cell[a] + 8 : cell[a];
+            tNext[a] = (boundary - eye[a]) * inv[a];
+            tDelta[a] = 8 * std::fabs(inv[a]);
+        }
+        double tCur = s0;
+        while (tCur < s1) {
+            int axis = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
+            double tExit = std::min(tNext[axis], s1);
+            int32_t id = mBlockIndex.getValue(openvdb::Coord(cell[0], cell[1], cell[2]));
+            if (id > 0) {
+                uint32_t box = mMedium.mBlocks.tightBox[size_t(id - 1)];
+                double a = tCur, b = tExit;
+                for (int ax = 0; ax < 3 && a < b; ++ax) {
+                    double lo = cell[ax] + double((box >> (4 * ax)) & 15);
+                    double hi = cell[ax] + double((box >> (12 + 4 * ax)) & 15);
+                    double ta = (lo - eye[ax]) * inv[ax], tb = (hi - eye[ax]) * inv[ax];
+                    if (ta > tb) std::swap(ta, tb);
+                    a = std::max(a, ta);
+                    b = std::min(b, tb);
+                }
+                emit(a, b);
+            }
+            tCur = tNext[axis];
+            cell[axis] += step[axis];
+            tNext[axis] += tDelta[axis];
         }
     }
 }
