@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -36,10 +37,13 @@ bool endsWith(const std::string& s, const std::string& suffix) {
 
 struct RenderArgs {
     std::string input, output, png, method, res, stats, saveScene;
-    int spp = 0, threads = -1;
-    long long seed = -1;
+    // Options the user did not give keep the scene's values; given ones are
+    // validated by the scene parser like any other key.
+    int spp = 0, threads = 0;
+    long long seed = 0;
     double step = 0, exposure = 0;
-    bool exposureSet = false, quiet = false, noProgress = false;
+    bool sppSet = false, threadsSet = false, seedSet = false, stepSet = false, exposureSet = false;
+    bool quiet = false, noProgress = false;
     std::vector<std::string> sets;
 };
 
@@ -70,11 +74,15 @@ int runRender(const RenderArgs& a) {
     // validated by the same parser and recorded in the output.
     std::vector<std::string> overrides = a.sets;
     if (!a.method.empty()) overrides.push_back("render.method=\"" + a.method + "\"");
-    if (a.spp > 0) overrides.push_back(str("render.spp=", a.spp));
-    else if (a.spp < 0 || (a.spp == 0 && false)) throw InputError(str("--spp ", a.spp, ": must be at least 1"));
-    if (a.seed >= 0) overrides.push_back(str("render.seed=", a.seed));
-    if (a.threads >= 0) overrides.push_back(str("render.threads=", a.threads));
-    if (a.step > 0) overrides.push_back(str("render.step=", a.step));
+    if (a.sppSet && a.spp < 1) throw InputError(str("--spp ", a.spp, ": must be at least 1"));
+    if (a.seedSet && a.seed < 0) throw InputError(str("--seed ", a.seed, ": must be a non-negative integer"));
+    if (a.threadsSet && a.threads < 0) throw InputError(str("--threads ", a.threads, ": must be 0 (all cores) or more"));
+    if (a.stepSet && !(a.step > 0 && std::isfinite(a.step)))
+        throw InputError(str("--step ", a.step, ": must be a positive length in world units"));
+    if (a.sppSet) overrides.push_back(str("render.spp=", a.spp));
+    if (a.seedSet) overrides.push_back(str("render.seed=", a.seed));
+    if (a.threadsSet) overrides.push_back(str("render.threads=", a.threads));
+    if (a.stepSet) overrides.push_back(str("render.step=", a.step));
     if (a.exposureSet) overrides.push_back(str("render.exposure=", a.exposure));
     if (!a.res.empty()) {
         int w = 0, h = 0;
@@ -85,7 +93,6 @@ int runRender(const RenderArgs& a) {
     }
 
     SceneDesc desc = endsWith(a.input, ".vdb") ? loadAutoScene(a.input, overrides) : loadSceneFile(a.input, overrides);
-    if (!a.saveScene.empty()) writeTextAtomic(a.saveScene, desc.json.dump(2) + "\n");
     std::unique_ptr<Scene> scene = buildScene(desc);
     makeMarcher(desc.render.method, *scene);  // validate before any work
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -109,6 +116,7 @@ int runRender(const RenderArgs& a) {
         {"vdbmarch:scene", desc.json.dump()},
     };
     writeExr(a.output, r.image, attrs);
+    if (!a.saveScene.empty()) writeTextAtomic(a.saveScene, desc.json.dump(2) + "\n");
     if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) {
@@ -171,11 +179,12 @@ int main(int argc, char** argv) {
     render->add_option("-o,--output", ra.output, "Output image (.exr, float RGBA, alpha = 1 - transmittance)")->required();
     render->add_option("--png", ra.png, "Also write an sRGB PNG preview");
     render->add_option("--method", ra.method, "Estimator: " + methods);
-    render->add_option("--spp", ra.spp, "Samples per pixel")->check(CLI::PositiveNumber);
+    auto flagSet = [](bool& b) { return [&b](const std::string&) { b = true; }; };
+    render->add_option("--spp", ra.spp, "Samples per pixel")->each(flagSet(ra.sppSet));
     render->add_option("--res", ra.res, "Resolution WIDTHxHEIGHT");
-    render->add_option("--seed", ra.seed, "Random seed")->check(CLI::NonNegativeNumber);
-    render->add_option("--threads", ra.threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
-    render->add_option("--step", ra.step, "March step in world units (default: one voxel)")->check(CLI::PositiveNumber);
+    render->add_option("--seed", ra.seed, "Random seed")->each(flagSet(ra.seedSet));
+    render->add_option("--threads", ra.threads, "Worker threads (0 = all cores)")->each(flagSet(ra.threadsSet));
+    render->add_option("--step", ra.step, "March step in world units (default: one voxel)")->each(flagSet(ra.stepSet));
     render->add_option("--exposure", ra.exposure, "PNG exposure in stops")->each([&](const std::string&) { ra.exposureSet = true; });
     render->add_option("--set", ra.sets, "Override a scene key: key.path=value (JSON value), repeatable");
     render->add_option("--stats", ra.stats, "Write timings and counters as JSON");
@@ -197,7 +206,9 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+        std::fprintf(stderr, "vdbmarch: error: %s\nRun with --help for usage.\n", e.what());
+        return 2;
     }
     try {
         if (*render) return runRender(ra);

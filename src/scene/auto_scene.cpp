@@ -15,8 +15,7 @@ nlohmann::json autoSceneJson(const std::string& vdbPath) {
     VdbGridSummary s = summarizeVdb(vdbPath, "");
     using nlohmann::json;
     BBox b = s.worldBounds;
-    if (b.empty()) {
-        warn(str(vdbPath, ": grid '", s.gridName, "' is empty: the render shows only the background"));
+    if (b.empty()) {  // the medium itself warns that it is empty
         b.lo = Vec3(-1);
         b.hi = Vec3(1);
     }

@@ -34,8 +34,14 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
             BBox b = m->worldBounds();
             if (std::isfinite(b.lo.x) && std::isfinite(b.hi.x)) bounds.expand(b);
         }
+        if (md.hasEmission && isBlack(md.sigma_a))
+            warn(str(desc.file, ": media[", i, "] (\"", md.name,
+                     "\") has emission but sigma_a = 0: emission enters as sigma_a L_e, so it is invisible"));
         scene->media.push_back(std::move(m));
     }
+    if (desc.render.maxDepth > 1 && desc.render.method == "uniform")
+        warn(str(desc.file, ": render.max_depth = ", desc.render.maxDepth,
+                 ": the uniform marcher computes single scattering (direct light) only in this release"));
 
     // Surfaces.
     scene->surfaceSet = std::make_unique<SurfaceSet>();

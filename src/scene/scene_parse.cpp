@@ -1,4 +1,7 @@
 // Scene JSON -> SceneDesc. Reads fields only; files are loaded later.
+#include <sys/stat.h>
+
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -12,18 +15,30 @@ namespace vdbmarch {
 
 namespace {
 
-// Line and column (1-based) of a byte offset, plus the offending line.
+// Line and column (1-based) of the start of the token that nlohmann's parser
+// rejected (its `byte` is one past the last character it read), plus the line.
 void lineColumn(const std::string& text, size_t byte, size_t& line, size_t& col, std::string& excerpt) {
+    size_t pos = std::min(byte > 0 ? byte - 1 : 0, text.empty() ? 0 : text.size() - 1);
+    auto isWordChar = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '+' || c == '-'; };
+    if (!text.empty() && text[pos] == '"') {
+        // Back to the opening quote of a string token (skipping escaped quotes).
+        size_t q = pos;
+        while (q > 0) {
+            --q;
+            if (text[q] == '"' && (q == 0 || text[q - 1] != '\\')) break;
+        }
+        if (text[q] == '"') pos = q;
+    } else if (!text.empty() && isWordChar(text[pos])) {
+        while (pos > 0 && isWordChar(text[pos - 1])) --pos;
+    }
     line = 1;
     size_t lineStart = 0;
-    byte = std::min(byte, text.size());
-    for (size_t i = 0; i < byte && i < text.size(); ++i)
+    for (size_t i = 0; i < pos && i < text.size(); ++i)
         if (text[i] == '\n') {
             ++line;
             lineStart = i + 1;
         }
-    col = byte - lineStart + (byte > lineStart ? 0 : 1);
-    if (byte > lineStart) col = byte - lineStart;  // nlohmann's byte is one past the bad char
+    col = pos - lineStart + 1;
     size_t lineEnd = text.find('\n', lineStart);
     excerpt = text.substr(lineStart, lineEnd == std::string::npos ? std::string::npos : lineEnd - lineStart);
     if (excerpt.size() > 120) excerpt = excerpt.substr(0, 120) + "...";
@@ -86,8 +101,10 @@ CameraDesc parseCamera(const JsonReader& r) {
     if (!(length(view) > 0))
         r.fail("look_at", str("equals camera.position (", c.position.x, ", ", c.position.y, ", ", c.position.z,
                               "): the camera has no viewing direction"));
-    if (!(length(c.up) > 0)) r.fail("up", "must be a non-zero vector");
-    if (length(cross(normalize(view), normalize(c.up))) < 1e-6f) r.fail("up", "is parallel to the viewing direction");
+    if (!(length(c.up) > 0)) r.fail("up", str("must be a non-zero vector, got ", jsonExcerpt(r.raw("up"))));
+    if (length(cross(normalize(view), normalize(c.up))) < 1e-6f)
+        r.fail("up", str(jsonExcerpt(r.raw("up")), " is parallel to the viewing direction (look_at - position = [",
+                         view.x, ", ", view.y, ", ", view.z, "])"));
     c.fovDeg = float(r.number("fov_deg", c.fovDeg));
     if (!(c.fovDeg > 0 && c.fovDeg < 180)) r.fail("fov_deg", str("must be in (0, 180) degrees, got ", c.fovDeg));
     c.widthWorld = float(r.positive("width_world", c.widthWorld));
@@ -383,10 +400,14 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
 }
 
 SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides) {
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0) throw IoError(str(path, ": cannot open scene file: ", std::strerror(errno)));
+    if (S_ISDIR(st.st_mode)) throw IoError(str(path, ": is a directory, not a scene file"));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw IoError(str(path, ": cannot open scene file: ", std::strerror(errno)));
     std::stringstream ss;
     ss << in.rdbuf();
+    if (in.bad()) throw IoError(str(path, ": cannot read scene file: ", std::strerror(errno)));
     return parseSceneText(ss.str(), path, overrides);
 }
 

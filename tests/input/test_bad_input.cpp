@@ -101,7 +101,7 @@ bool hasNumberToken(const std::string& msg, const std::string& number) {
     return std::regex_search(msg, re);
 }
 
-class BadInput : public testing::Test {
+class BadInput : public ::testing::Test {
 protected:
     void SetUp() override {
         setWarningsQuiet(true);

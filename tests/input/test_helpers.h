@@ -61,17 +61,18 @@ inline std::vector<std::string> tempLeftovers(const std::string& dir) {
     return out;
 }
 
-// A fresh directory per test, removed afterwards.
+// A fresh directory per test, removed afterwards (kept when VDBMARCH_KEEP_TEST_DIRS is set).
 class TempDir {
 public:
     TempDir() {
-        std::string pattern = (fs::path(testing::TempDir()) / "vdbmarch_badinput_XXXXXX").string();
+        std::string pattern = (fs::path(::testing::TempDir()) / "vdbmarch_badinput_XXXXXX").string();
         std::vector<char> buf(pattern.begin(), pattern.end());
         buf.push_back('\0');
         if (!mkdtemp(buf.data())) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
         mPath = buf.data();
     }
     ~TempDir() {
+        if (std::getenv("VDBMARCH_KEEP_TEST_DIRS")) return;  // for debugging a failure
         std::error_code ec;
         fs::remove_all(mPath, ec);
     }
