@@ -77,6 +77,11 @@ inline void coordinateSystem(const Vec3& n, Vec3& s, Vec3& t) {
 struct Ray {
     Vec3 o, d;  // d is unit length everywhere in the renderer
     Vec3 at(float t) const { return o + d * t; }
+    // In double precision: exact lattice positions even when t is large.
+    Vec3 at(double t) const {
+        return Vec3(float(double(o.x) + double(d.x) * t), float(double(o.y) + double(d.y) * t),
+                    float(double(o.z) + double(d.z) * t));
+    }
 };
 
 struct BBox {

@@ -16,7 +16,7 @@ inline uint64_t mixBits(uint64_t v) {
 }
 
 inline uint64_t hashValues(uint64_t a, uint64_t b = 0, uint64_t c = 0) {
-    return mixBits(a ^ mixBits(b + 0x9e3779b97f4a7c15ULL ^ mixBits(c + 0x632be59bd9b4e019ULL)));
+    return mixBits(a ^ mixBits((b + 0x9e3779b97f4a7c15ULL) ^ mixBits(c + 0x632be59bd9b4e019ULL)));
 }
 
 class Rng {

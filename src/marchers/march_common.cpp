@@ -18,12 +18,12 @@ void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp) {
         float d = ctx.queries[size_t(mi)]->density(p);
         if (!(d > 0)) continue;
         const Medium& m = *ctx.scene.media[size_t(mi)];
-        Color sa = m.sigma_a * d, ss = m.sigma_s * d;
+        Color sa = min(m.sigma_a * d, Color(MaxCoefficient)), ss = min(m.sigma_s * d, Color(MaxCoefficient));
         mp.sigma_a += sa;
         mp.sigma_s += ss;
         if (m.hasEmission) {
             float e = ctx.queries[size_t(mi)]->emission(p);
-            if (e > 0) mp.emission += sa * m.emissionColor * e;
+            if (e > 0) mp.emission += sa * m.emissionColor * e;  // normalised below
         }
         if (!isBlack(ss) && mp.count < MaxMediaPerPoint) {
             mp.sigmaS[mp.count] = ss;
@@ -32,6 +32,8 @@ void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp) {
         }
     }
     mp.sigma_t = mp.sigma_a + mp.sigma_s;
+    if (!isBlack(mp.emission))
+        for (int c = 0; c < 3; ++c) mp.emission[c] = mp.sigma_a[c] > 0 ? mp.emission[c] / mp.sigma_a[c] : 0.f;
 }
 
 void regionIntervals(ThreadContext& ctx, int region, const Ray& r, float tMin, float tMax,
@@ -53,9 +55,10 @@ void regionIntervals(ThreadContext& ctx, int region, const Ray& r, float tMin, f
     }
 }
 
-Color scatteringPhase(const MediumPoint& mp, float cosTheta) {
+Color phaseMixture(const MediumPoint& mp, float cosTheta) {
+    if (mp.count == 1) return Color(hgPhase(cosTheta, mp.g[0]));
     Color c(0);
-    for (int i = 0; i < mp.count; ++i) c += mp.sigmaS[i] * hgPhase(cosTheta, mp.g[i]);
+    for (int i = 0; i < mp.count; ++i) c += (mp.sigmaS[i] / mp.sigma_s) * hgPhase(cosTheta, mp.g[i]);
     return c;
 }
 
@@ -112,8 +115,9 @@ Color opticalDepth(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng
         q.activeIntervals(r, 0.f, tEnd, ctx.shadowIntervals);
         float sum = 0;
         for (const Interval& iv : ctx.shadowIntervals) {
-            float k = std::ceil(iv.t0 / step - u);
-            for (float t = (k + u) * step; t < iv.t1; k += 1, t = (k + u) * step) {
+            // Lattice index in double: k + 1 must never round back to k.
+            double k = std::ceil(double(iv.t0) / step - u);
+            for (double t = (k + u) * step; t < iv.t1; k += 1, t = (k + u) * step) {
                 sum += q.density(r.at(t));
                 ++ctx.counters.shadowSamples;
                 if (minComponent(tau + sigmaT * (sum * step)) > depthCutoff) return tau + sigmaT * (sum * step);
@@ -168,7 +172,7 @@ Color directInScattering(ThreadContext& ctx, int region, const Vec3& p, const Ve
         if (!light.sample(p, u1, u2, ls) || isBlack(ls.L)) continue;
         // cos between the light's travel direction (-wi) and the scattered
         // direction towards the camera (-rayDir).
-        Color f = scatteringPhase(mp, dot(ls.wi, rayDir));
+        Color f = phaseMixture(mp, dot(ls.wi, rayDir));
         if (isBlack(f)) continue;
         Color T = shadowTransmittance(ctx, region, p, ls.wi, ls.dist, rng);
         Ls += f * ls.L * T;
@@ -190,7 +194,7 @@ Color directInScattering(ThreadContext& ctx, int region, const Vec3& p, const Ve
         for (int i = 0; i < mp.count; ++i) pdf += w[i] / total * hgPhase(cosTheta, mp.g[i]);
         if (pdf > 0) {
             Color T = shadowTransmittance(ctx, region, p, wi, Infinity, rng);
-            Ls += scatteringPhase(mp, cosTheta) * scene.background * T / pdf;
+            Ls += phaseMixture(mp, cosTheta) * scene.background * T / pdf;
         }
     }
     return Ls;

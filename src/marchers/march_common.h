@@ -24,10 +24,13 @@ struct ThreadContext {
     RenderCounters counters;
 };
 
-// Coefficients of all media of a region at one point.
+// Coefficients of all media of a region at one point. Each medium's
+// coefficients are clamped to MaxCoefficient so sums stay finite.
+constexpr float MaxCoefficient = 1e30f;
+
 struct MediumPoint {
     Color sigma_a, sigma_s, sigma_t;
-    Color emission;  // sigma_a * L_e, the source term of eq. 1
+    Color emission;  // L_e averaged with weights sigma_a,i (sigma_a L_e / sigma_a)
     int count = 0;   // media that scatter here, for the phase mixture
     Color sigmaS[MaxMediaPerPoint];
     float g[MaxMediaPerPoint];
@@ -40,9 +43,10 @@ void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp);
 void regionIntervals(ThreadContext& ctx, int region, const Ray& r, float tMin, float tMax,
                      std::vector<Interval>& out);
 
-// Sum over the media at a point of sigma_s,i * p_i(cos); cos is between the
-// light's travel direction and the scattered direction.
-Color scatteringPhase(const MediumPoint& mp, float cosTheta);
+// Phase function of the mixture at a point: sum_i sigma_s,i p_i(cos) / sigma_s
+// per channel; cos is between the light's travel direction and the scattered
+// direction. Normalised so that huge coefficients cannot overflow.
+Color phaseMixture(const MediumPoint& mp, float cosTheta);
 
 // Transmittance from p along direction wi over distance `dist` (Infinity for
 // the environment/directional lights), starting in `region`. Interfaces are
@@ -50,9 +54,8 @@ Color scatteringPhase(const MediumPoint& mp, float cosTheta);
 // Optical depth by uniform steps with a random offset.
 Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const Vec3& wi, float dist, Rng& rng);
 
-// In-scattered radiance from direct light at p towards -rayDir, multiplied by
-// the scattering coefficients (sigma_s L_i of eq. 1 restricted to light that
-// arrives unscattered): next-event estimation to every light, and one
+// In-scattered radiance L_i (eq. 3) at p towards -rayDir from light that
+// arrives unscattered: next-event estimation to every light, and one
 // phase-sampled direction for the background environment.
 Color directInScattering(ThreadContext& ctx, int region, const Vec3& p, const Vec3& rayDir, const MediumPoint& mp,
                          Rng& rng);

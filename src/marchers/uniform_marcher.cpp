@@ -5,7 +5,8 @@
 // constant-medium assumption of eq. 5: the step contributes
 //   T_k * S(x_k, dx) * (sigma_a L_e + sigma_s L_i),  S = (1 - e^{-kappa dx}) / kappa  (eq. 7)
 // and T_{k+1} = T_k e^{-kappa dx}. S replaces eq. 5's dx so optically thick
-// steps cannot over-count (S -> dx as kappa dx -> 0).
+// steps cannot over-count (S -> dx as kappa dx -> 0). S sigma_x is evaluated as
+// (1 - e^{-kappa dx}) (sigma_x / kappa) so that no product can overflow.
 #include <cmath>
 
 #include "core/error.h"
@@ -86,28 +87,46 @@ private:
                       Color& beta) const {
         const Scene& scene = mScene;
         if (scene.regions[size_t(region)].media.empty()) return true;
-        regionIntervals(ctx, region, ray, 0.f, tEnd, ctx.intervals);
+        // An unbounded fog makes the last interval infinite. Past the scene's
+        // finite content the fog is homogeneous: march until its transmittance
+        // is below e^-20 (at most 1e5 steps), then T(infinity) = 0 in every
+        // channel where it extinguishes.
+        const Color& K = scene.regions[size_t(region)].unboundedSigmaT;
+        const bool infiniteTail = !std::isfinite(tEnd) && !isBlack(K);
+        float tLimit = tEnd;
+        if (infiniteTail) {
+            float kMin = Infinity;
+            for (int c = 0; c < 3; ++c)
+                if (K[c] > 0) kMin = std::min(kMin, K[c]);
+            tLimit = length(ray.o) + 2 * scene.sceneScale + std::min(20.f / kMin, 1e5f * scene.step);
+        }
+        regionIntervals(ctx, region, ray, 0.f, tLimit, ctx.intervals);
         double active = 0;
         const float dx = scene.step;
         const float u = rng.uniform();  // one random offset per segment (eq. 5 with jitter)
         MediumPoint mp;
         for (const Interval& iv : ctx.intervals) {
             active += double(std::min(iv.t1, 1e30f) - iv.t0);
-            float k = std::ceil(iv.t0 / dx - u);
-            for (float t = (k + u) * dx; t < iv.t1; k += 1, t = (k + u) * dx) {
+            // Lattice index in double: k + 1 must never round back to k.
+            double k = std::ceil(double(iv.t0) / dx - u);
+            for (double t = (k + u) * dx; t < iv.t1; k += 1, t = (k + u) * dx) {
                 Vec3 x = ray.at(t);
                 evalMedia(ctx, region, x, mp);
                 ++ctx.counters.marchSamples;
                 if (isBlack(mp.sigma_t)) continue;
-                Color source = mp.emission + directInScattering(ctx, region, x, ray.d, mp, rng);
-                Color S, Tstep;
+                Color Li = mp.count > 0 ? directInScattering(ctx, region, x, ray.d, mp, rng) : Color(0);
+                // S sigma_x = (1 - e^{-kappa dx}) sigma_x / kappa: the absorbed
+                // fraction of the step split by albedo, bounded for any kappa.
+                Color Tstep, absorbedA, absorbedS;
                 for (int c = 0; c < 3; ++c) {
-                    float tauStep = mp.sigma_t[c] * dx;
+                    float kappa = mp.sigma_t[c];
+                    float tauStep = kappa * dx;
                     Tstep[c] = std::exp(-tauStep);
-                    // S = (1 - e^{-tau}) / sigma_t, written to stay exact for tiny tau.
-                    S[c] = tauStep > 1e-4f ? -std::expm1(-tauStep) / mp.sigma_t[c] : dx * (1 - 0.5f * tauStep);
+                    float oneMinusT = tauStep > 1e-4f ? -std::expm1(-tauStep) : tauStep * (1 - 0.5f * tauStep);
+                    absorbedA[c] = kappa > 0 ? oneMinusT * (mp.sigma_a[c] / kappa) : 0.f;
+                    absorbedS[c] = kappa > 0 ? oneMinusT * (mp.sigma_s[c] / kappa) : 0.f;
                 }
-                L += beta * S * source;
+                L += beta * (absorbedA * mp.emission + absorbedS * Li);
                 beta *= Tstep;
                 float m = maxComponent(beta);
                 if (m < RouletteThreshold) {
@@ -122,6 +141,9 @@ private:
             }
         }
         addLengths(ctx, tEnd, active);
+        if (infiniteTail)
+            for (int c = 0; c < 3; ++c)
+                if (K[c] > 0) beta[c] = 0;
         return true;
     }
 

@@ -31,6 +31,11 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
         if (!m->isVacuum() || m->hasEmission) {
             scene->regions[2 + i].media.push_back(int(i));
             if (!isInterior[i]) scene->regions[Scene::WorldRegion].media.push_back(int(i));
+            if (md.type == MediumDesc::Type::Homogeneous && !md.hasBounds) {
+                Color k = min(md.sigma_a + md.sigma_s, Color(1e30f));
+                scene->regions[2 + i].unboundedSigmaT += k;
+                if (!isInterior[i]) scene->regions[Scene::WorldRegion].unboundedSigmaT += k;
+            }
             BBox b = m->worldBounds();
             if (std::isfinite(b.lo.x) && std::isfinite(b.hi.x)) bounds.expand(b);
         }

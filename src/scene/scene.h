@@ -17,6 +17,7 @@ namespace vdbmarch {
 // surfaces), vacuum, or the single medium inside a surface.
 struct Region {
     std::vector<int> media;
+    Color unboundedSigmaT{0, 0, 0};  // summed extinction of its unbounded homogeneous media
 };
 
 struct SurfaceInfo {
