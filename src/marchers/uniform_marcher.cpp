@@ -60,18 +60,26 @@ public:
                     break;
                 case MaterialDesc::Type::Dielectric: {
                     // Smooth Fresnel: reflect with probability F, else refract;
-                    // the weights F/F and (1-F)/(1-F) cancel.
-                    Vec3 n = entering ? h.n : -h.n;  // faces the incoming ray
+                    // the weights F/F and (1-F)/(1-F) cancel. The shading
+                    // normal bends the directions; the geometric normal decides
+                    // the side, and wins when the two disagree.
                     float eta = entering ? s.material.ior : 1 / s.material.ior;
+                    Vec3 ng = entering ? h.n : -h.n;  // faces the incoming ray
+                    Vec3 n = dot(h.ns, ng) > 0 ? h.ns : -h.ns;
+                    if (-dot(ray.d, n) <= 0) n = ng;  // shading normal faces away from the ray
                     float cosI = -dot(ray.d, n), cosT;
                     float F = fresnelDielectric(cosI, eta, &cosT);
-                    Vec3 d;
-                    if (rng.uniform() < F) {
-                        d = ray.d + n * (2 * cosI);
-                    } else {
-                        d = ray.d / eta + n * (cosI / eta - cosT);
-                        region = entering ? s.interiorRegion : s.exteriorRegion;
+                    bool reflect = rng.uniform() < F;
+                    Vec3 d = reflect ? ray.d + n * (2 * cosI) : ray.d / eta + n * (cosI / eta - cosT);
+                    if (reflect ? dot(d, ng) <= 0 : dot(d, ng) >= 0) {
+                        // The shading normal sent the ray to the wrong side of
+                        // the true surface: redo the event with the geometric one.
+                        cosI = -dot(ray.d, ng);
+                        F = fresnelDielectric(cosI, eta, &cosT);
+                        reflect = reflect || F >= 1;
+                        d = reflect ? ray.d + ng * (2 * cosI) : ray.d / eta + ng * (cosI / eta - cosT);
                     }
+                    if (!reflect) region = entering ? s.interiorRegion : s.exteriorRegion;
                     d = normalize(d);
                     ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
                     break;

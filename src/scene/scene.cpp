@@ -82,7 +82,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
             orientOutward(mesh);
         }
         for (const auto& p : mesh.positions) bounds.expand(p);
-        scene->surfaceSet->addMesh(std::move(mesh), int(i));
+        scene->surfaceSet->addMesh(std::move(mesh), int(i), sd.smoothNormals);
     }
     scene->surfaceSet->commit();
     for (const auto& l : desc.lights) {

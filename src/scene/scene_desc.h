@@ -58,6 +58,7 @@ struct SurfaceDesc {
     Mat4 transform = Mat4::identity();
     MaterialDesc material;
     std::string interior, exterior;  // empty: vacuum inside / world media outside
+    bool smoothNormals = false;      // default true for vdb_isosurface
 };
 
 struct RenderSettings {

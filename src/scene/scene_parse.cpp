@@ -215,7 +215,8 @@ MediumDesc parseMedium(const JsonReader& r, size_t index) {
 
 SurfaceDesc parseSurface(const JsonReader& r) {
     SurfaceDesc s;
-    r.allowOnly({"shape", "file", "grid", "isovalue", "transform", "material", "interior", "exterior"});
+    r.allowOnly({"shape", "file", "grid", "isovalue", "transform", "material", "interior", "exterior",
+                 "smooth_normals"});
     std::string shape = r.choice("shape", "", {"sphere", "box", "mesh", "vdb_isosurface"});
     if (shape == "sphere") s.shape = SurfaceDesc::Shape::Sphere;
     else if (shape == "box") s.shape = SurfaceDesc::Shape::Box;
@@ -251,6 +252,10 @@ SurfaceDesc parseSurface(const JsonReader& r) {
             s.material.type = MaterialDesc::Type::Interface;
         }
     }
+    bool meshLike = s.shape == SurfaceDesc::Shape::Mesh || s.shape == SurfaceDesc::Shape::VdbIsosurface;
+    if (r.has("smooth_normals") && !meshLike)
+        r.fail("smooth_normals", "is only used by shape \"mesh\" or \"vdb_isosurface\"");
+    s.smoothNormals = r.boolean("smooth_normals", s.shape == SurfaceDesc::Shape::VdbIsosurface);
     s.interior = r.string("interior", "");
     s.exterior = r.string("exterior", "");
     return s;

@@ -49,7 +49,21 @@ SurfaceSet::~SurfaceSet() {
     if (mEmbree->device) rtcReleaseDevice(mEmbree->device);
 }
 
-void SurfaceSet::addMesh(TriangleMesh mesh, int surfaceIndex) {
+void SurfaceSet::addMesh(TriangleMesh mesh, int surfaceIndex, bool smoothNormals) {
+    std::vector<Vec3> normals;
+    if (smoothNormals) {
+        // Area-weighted: the unnormalised cross product carries twice the area.
+        normals.assign(mesh.positions.size(), Vec3(0));
+        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+            const uint32_t* tri = &mesh.indices[t];
+            Vec3 n = cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
+            for (int k = 0; k < 3; ++k) normals[tri[k]] += n;
+        }
+        for (auto& n : normals) {
+            float len = length(n);
+            n = len > 0 ? n / len : Vec3(0);
+        }
+    }
     RTCGeometry g = rtcNewGeometry(mEmbree->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), mesh.positions.size()));
@@ -67,7 +81,7 @@ void SurfaceSet::addMesh(TriangleMesh mesh, int surfaceIndex) {
     mEmbree->check("adding a mesh");
     if (mEmbree->geomToIndex.size() <= id) mEmbree->geomToIndex.resize(id + 1);
     mEmbree->geomToIndex[id] = unsigned(mGeometries.size());
-    mGeometries.push_back({surfaceIndex, false, std::move(mesh), Transform()});
+    mGeometries.push_back({surfaceIndex, false, std::move(mesh), Transform(), std::move(normals)});
 }
 
 void SurfaceSet::addSphere(const Transform& toWorld, int surfaceIndex) {
@@ -96,7 +110,7 @@ void SurfaceSet::addSphere(const Transform& toWorld, int surfaceIndex) {
     mEmbree->check("adding a sphere");
     if (mEmbree->geomToIndex.size() <= id) mEmbree->geomToIndex.resize(id + 1);
     mEmbree->geomToIndex[id] = unsigned(mGeometries.size());
-    mGeometries.push_back({surfaceIndex, true, TriangleMesh(), toWorld});
+    mGeometries.push_back({surfaceIndex, true, TriangleMesh(), toWorld, {}});
 }
 
 void SurfaceSet::commit() {
@@ -141,8 +155,15 @@ bool SurfaceSet::intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit
         const Vec3& b = g.mesh.positions[tri[1]];
         const Vec3& c = g.mesh.positions[tri[2]];
         hit.n = normalize(cross(b - a, c - a));
+        if (!g.vertexNormals.empty()) {
+            float u = rh.hit.u, v = rh.hit.v;  // barycentrics of vertices 1 and 2
+            Vec3 ns = g.vertexNormals[tri[0]] * (1 - u - v) + g.vertexNormals[tri[1]] * u + g.vertexNormals[tri[2]] * v;
+            float len = length(ns);
+            hit.ns = len > 0 ? ns / len : hit.n;
+        }
     }
     if (!isFinite(hit.n)) hit.n = -r.d;  // degenerate triangle: treat as facing the ray
+    if (g.vertexNormals.empty() || !isFinite(hit.ns)) hit.ns = hit.n;
     return true;
 }
 

@@ -17,6 +17,7 @@ struct SurfaceHit {
     float t = Infinity;
     Vec3 p;
     Vec3 n;        // unit geometric normal, pointing outwards
+    Vec3 ns;       // unit shading normal (interpolated vertex normals, or n)
     int surface = -1;
 };
 
@@ -27,7 +28,8 @@ public:
     SurfaceSet(const SurfaceSet&) = delete;
     SurfaceSet& operator=(const SurfaceSet&) = delete;
 
-    void addMesh(TriangleMesh worldMesh, int surfaceIndex);
+    // smoothNormals: interpolate area-weighted vertex normals for shading.
+    void addMesh(TriangleMesh worldMesh, int surfaceIndex, bool smoothNormals = false);
     void addSphere(const Transform& objectToWorld, int surfaceIndex);
     void commit();
     bool empty() const { return mGeometries.empty(); }
@@ -44,6 +46,7 @@ private:
         bool sphere;
         TriangleMesh mesh;
         Transform toWorld;
+        std::vector<Vec3> vertexNormals;  // empty: flat shading
     };
     std::unique_ptr<Embree> mEmbree;
     std::vector<Geometry> mGeometries;
