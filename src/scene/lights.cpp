@@ -29,23 +29,28 @@ Light::Light(const LightDesc& d) : mDesc(d) {
     }
 }
 
+namespace {
+// Direction and distance from x to a point source; false when x is on it.
+bool towardsPoint(const Vec3& x, const Vec3& position, LightSample& s, float& d2) {
+    Vec3 to = position - x;
+    d2 = lengthSquared(to);
+    if (!(d2 > 0)) return false;
+    s.dist = std::sqrt(d2);
+    s.wi = to / s.dist;
+    return true;
+}
+}  // namespace
+
 bool Light::sample(const Vec3& x, float u1, float u2, LightSample& s) const {
+    float d2;
     switch (mDesc.type) {
         case LightDesc::Type::Point: {
-            Vec3 to = mDesc.position - x;
-            float d2 = lengthSquared(to);
-            if (!(d2 > 0)) return false;
-            s.dist = std::sqrt(d2);
-            s.wi = to / s.dist;
+            if (!towardsPoint(x, mDesc.position, s, d2)) return false;
             s.L = mDesc.intensity / d2;
             return true;
         }
         case LightDesc::Type::Spot: {
-            Vec3 to = mDesc.position - x;
-            float d2 = lengthSquared(to);
-            if (!(d2 > 0)) return false;
-            s.dist = std::sqrt(d2);
-            s.wi = to / s.dist;
+            if (!towardsPoint(x, mDesc.position, s, d2)) return false;
             float cosTheta = dot(-s.wi, mDesc.direction);
             if (cosTheta <= mCosCone) return false;
             float falloff = 1;

@@ -49,6 +49,16 @@ SurfaceSet::~SurfaceSet() {
     if (mEmbree->device) rtcReleaseDevice(mEmbree->device);
 }
 
+// Commits and attaches a geometry that becomes mGeometries[mGeometries.size()].
+void SurfaceSet::attach(RTCGeometry g, const char* what) {
+    rtcCommitGeometry(g);
+    unsigned id = rtcAttachGeometry(mEmbree->scene, g);
+    rtcReleaseGeometry(g);
+    mEmbree->check(what);
+    if (mEmbree->geomToIndex.size() <= id) mEmbree->geomToIndex.resize(id + 1);
+    mEmbree->geomToIndex[id] = unsigned(mGeometries.size());
+}
+
 void SurfaceSet::addMesh(TriangleMesh mesh, int surfaceIndex, bool smoothNormals) {
     std::vector<Vec3> normals;
     if (smoothNormals) {
@@ -75,12 +85,7 @@ void SurfaceSet::addMesh(TriangleMesh mesh, int surfaceIndex, bool smoothNormals
     auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                3 * sizeof(unsigned), mesh.triangleCount()));
     std::copy(mesh.indices.begin(), mesh.indices.end(), idx);
-    rtcCommitGeometry(g);
-    unsigned id = rtcAttachGeometry(mEmbree->scene, g);
-    rtcReleaseGeometry(g);
-    mEmbree->check("adding a mesh");
-    if (mEmbree->geomToIndex.size() <= id) mEmbree->geomToIndex.resize(id + 1);
-    mEmbree->geomToIndex[id] = unsigned(mGeometries.size());
+    attach(g, "adding a mesh");
     mGeometries.push_back({surfaceIndex, false, std::move(mesh), Transform(), std::move(normals)});
 }
 
@@ -104,12 +109,7 @@ void SurfaceSet::addSphere(const Transform& toWorld, int surfaceIndex) {
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = float(m.m[r][c]);
     rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
-    rtcCommitGeometry(inst);
-    unsigned id = rtcAttachGeometry(mEmbree->scene, inst);
-    rtcReleaseGeometry(inst);
-    mEmbree->check("adding a sphere");
-    if (mEmbree->geomToIndex.size() <= id) mEmbree->geomToIndex.resize(id + 1);
-    mEmbree->geomToIndex[id] = unsigned(mGeometries.size());
+    attach(inst, "adding a sphere");
     mGeometries.push_back({surfaceIndex, true, TriangleMesh(), toWorld, {}});
 }
 

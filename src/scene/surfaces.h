@@ -11,6 +11,8 @@
 #include "scene/mesh.h"
 #include "scene/scene_desc.h"
 
+struct RTCGeometryTy;  // Embree's geometry handle, kept out of this header
+
 namespace vdbmarch {
 
 struct SurfaceHit {
@@ -48,6 +50,7 @@ private:
         Transform toWorld;
         std::vector<Vec3> vertexNormals;  // empty: flat shading
     };
+    void attach(::RTCGeometryTy* geometry, const char* what);
     std::unique_ptr<Embree> mEmbree;
     std::vector<Geometry> mGeometries;
 };
