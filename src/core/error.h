@@ -14,6 +14,14 @@ struct InputError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// A bad value at a key of a JSON document: `keyPath` (e.g. "media[0].g") lets
+// the parser add the line and column where the key is written.
+struct SceneKeyError : InputError {
+    SceneKeyError(const std::string& file, const std::string& keyPath, const std::string& message)
+        : InputError(file + ": " + message), file(file), keyPath(keyPath), detail(message) {}
+    std::string file, keyPath, detail;  // what() = file + ": " + detail
+};
+
 // The file system refused: cannot open, read or write.
 struct IoError : std::runtime_error {
     using std::runtime_error::runtime_error;

@@ -51,14 +51,14 @@ void JsonReader::allowOnly(const std::vector<std::string>& known) const {
         bool ok = false;
         for (const auto& k : known) ok = ok || (k == it.key());
         if (ok) continue;
-        std::string msg = str(mFile, ": unknown key '", keyPath(it.key().c_str()), "'");
+        std::string msg = str("unknown key '", keyPath(it.key().c_str()), "'");
         std::string near = nearestKey(it.key(), known);
         if (!near.empty()) msg += str(" (did you mean '", near, "'?)");
         else {
             msg += "; known keys here:";
             for (const auto& k : known) msg += " " + k;
         }
-        throw InputError(msg);
+        throw SceneKeyError(mFile, keyPath(it.key().c_str()), msg);
     }
 }
 
@@ -78,7 +78,7 @@ std::string JsonReader::keyPath(const char* key, size_t index) const {
 }
 
 void JsonReader::fail(const char* key, const std::string& message) const {
-    throw InputError(str(mFile, ": ", keyPath(key), ": ", message));
+    throw SceneKeyError(mFile, keyPath(key), str(keyPath(key), ": ", message));
 }
 
 double JsonReader::number(const char* key) const {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "scene/json_locate.h"
 #include "scene/json_reader.h"
 #include "scene/scene_desc.h"
 
@@ -401,7 +402,27 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
                              std::string(col > 0 ? col - 1 : 0, ' '), "^"));
     }
     for (const auto& o : overrides) applyOverride(doc, o);
-    return parseSceneJson(doc, file);
+    try {
+        return parseSceneJson(doc, file);
+    } catch (const SceneKeyError& e) {
+        // Point at the key in the file, unless an override replaced it (then
+        // the bad value is not in the text).
+        for (const auto& o : overrides) {
+            std::string path = o.substr(0, o.find('='));
+            std::string asKeyPath;
+            std::stringstream ss(path);
+            for (std::string part; std::getline(ss, part, '.');) {
+                bool index = !part.empty() && part.find_first_not_of("0123456789") == std::string::npos;
+                asKeyPath += index ? "[" + part + "]" : (asKeyPath.empty() ? "" : ".") + part;
+            }
+            if (e.keyPath.compare(0, asKeyPath.size(), asKeyPath) == 0) throw;
+        }
+        size_t offset = locateJsonPath(text, e.keyPath);
+        if (offset == std::string::npos) throw;
+        size_t line, col;
+        lineAndColumn(text, offset, line, col);
+        throw InputError(str(file, ":", line, ":", col, ": ", e.detail));
+    }
 }
 
 SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides) {
