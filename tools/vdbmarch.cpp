@@ -167,6 +167,7 @@ int runInfo(const std::string& file) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    removeTemporaryFilesOnInterrupt();
     CLI::App app{"vdbmarch: physically based ray marching of OpenVDB smoke, clouds and fog"};
     app.set_version_flag("--version", std::string("vdbmarch ") + VDBMARCH_VERSION);
     app.require_subcommand(1);

@@ -3,6 +3,7 @@
 #include "core/error.h"
 
 #include <atomic>
+#include <csignal>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -16,6 +17,36 @@ namespace vdbmarch {
 namespace {
 
 std::atomic<unsigned> gTempCounter{0};
+
+// Temporary files in flight, for the interrupt handler: fixed storage, since
+// a signal handler may only touch plain memory and call unlink().
+constexpr int MaxLiveTemps = 32;
+constexpr size_t MaxTempPath = 4096;
+char gLiveTemps[MaxLiveTemps][MaxTempPath];
+std::atomic<bool> gLiveUsed[MaxLiveTemps];
+
+int registerTemp(const std::string& path) {
+    if (path.size() >= MaxTempPath) return -1;
+    for (int i = 0; i < MaxLiveTemps; ++i) {
+        bool expected = false;
+        if (gLiveUsed[i].compare_exchange_strong(expected, true)) {
+            std::memcpy(gLiveTemps[i], path.c_str(), path.size() + 1);
+            return i;
+        }
+    }
+    return -1;  // untracked: still removed by the destructor
+}
+
+void unregisterTemp(int slot) {
+    if (slot >= 0) gLiveUsed[slot].store(false);
+}
+
+extern "C" void removeTempsAndReraise(int sig) {
+    for (int i = 0; i < MaxLiveTemps; ++i)
+        if (gLiveUsed[i].load()) ::unlink(gLiveTemps[i]);
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+}
 
 // Splits "a/b/c.exr" into "a/b" and "c.exr"; a bare name lives in ".".
 void splitPath(const std::string& path, std::string& dir, std::string& name) {
@@ -38,10 +69,16 @@ AtomicFile::AtomicFile(std::string finalPath) : mFinalPath(std::move(finalPath))
     // pid + per-process counter keeps concurrent writers (threads or
     // processes) from sharing a temporary file.
     mTempPath = str(dir == "/" ? "" : dir, "/.", name, ".tmp-", ::getpid(), "-", gTempCounter++);
+    mSlot = registerTemp(mTempPath);
 }
 
 AtomicFile::~AtomicFile() {
     if (!mCommitted) ::unlink(mTempPath.c_str());
+    unregisterTemp(mSlot);
+}
+
+void removeTemporaryFilesOnInterrupt() {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, removeTempsAndReraise);
 }
 
 void AtomicFile::commit() {

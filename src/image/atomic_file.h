@@ -27,7 +27,13 @@ private:
     std::string mFinalPath;
     std::string mTempPath;
     bool mCommitted = false;
+    int mSlot = -1;  // registration for removeTemporaryFilesOnInterrupt()
 };
+
+// Installs SIGINT/SIGTERM/SIGHUP handlers that delete the temporary files of
+// live AtomicFiles and then die by the same signal: an interrupted run leaves
+// no partial file behind.
+void removeTemporaryFilesOnInterrupt();
 
 // Throws IoError if the directory that would hold `path` does not exist or is
 // not writable, or if `path` is itself a directory. Called before rendering so
