@@ -24,7 +24,16 @@ public:
     ProgressBar(bool enabled, int total) : mEnabled(enabled), mTotal(total) {}
     void tick() {
         if (!mEnabled) return;
-        int done = ++mDone;
+        show(++mDone);
+    }
+    // Fraction in [0, 1] (time budgets).
+    void set(double fraction) {
+        if (!mEnabled) return;
+        show(int(std::min(1.0, std::max(0.0, fraction)) * mTotal));
+    }
+
+private:
+    void show(int done) {
         int percent = int(100LL * done / mTotal);
         std::lock_guard<std::mutex> lock(mMutex);
         if (percent == mShown) return;
@@ -35,7 +44,6 @@ public:
         std::fflush(stderr);
     }
 
-private:
     bool mEnabled;
     int mTotal;
     std::atomic<int> mDone{0};
@@ -51,48 +59,85 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const int w = scene.camera->width(), h = scene.camera->height();
     const int tilesX = (w + TileSize - 1) / TileSize, tilesY = (h + TileSize - 1) / TileSize;
     const int tiles = tilesX * tilesY;
+    const bool timed = options.timeBudget > 0;
     RenderResult result;
     result.image = Image(w, h);
+    std::vector<Color> sums(size_t(w) * size_t(h), Color(0));
+    std::vector<double> transmittances(size_t(w) * size_t(h), 0.0);
     std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
-    ProgressBar progress(options.progress, tiles);
+    ProgressBar progress(options.progress, timed ? 1000 : tiles);
     const int threads = rs.threads > 0 ? rs.threads : tbb::info::default_concurrency();
     result.threads = threads;
     auto start = std::chrono::steady_clock::now();
+    auto runStart = options.runStart ? *options.runStart : start;
     tbb::task_arena arena(threads);
-    arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
-            for (int tile = range.begin(); tile != range.end(); ++tile) {
-                ThreadContext ctx(scene);
-                const int x0 = (tile % tilesX) * TileSize, y0 = (tile / tilesX) * TileSize;
-                for (int y = y0; y < std::min(y0 + TileSize, h); ++y)
-                    for (int x = x0; x < std::min(x0 + TileSize, w); ++x) {
-                        const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);
-                        Color sum(0);
-                        double transmittance = 0;
-                        for (int s = 0; s < rs.spp; ++s) {
-                            Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
-                            float jx = 0.5f, jy = 0.5f;
-                            if (rs.pixelJitter) {
-                                jx = rng.uniform();
-                                jy = rng.uniform();
+
+    // One pass renders samples [s0, s1) of every pixel. Each pixel sums its
+    // samples in index order, so the image depends only on the final sample
+    // count, never on how samples were split into passes or threads.
+    auto renderPass = [&](int s0, int s1) {
+        arena.execute([&] {
+            tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
+                for (int tile = range.begin(); tile != range.end(); ++tile) {
+                    ThreadContext ctx(scene);
+                    const int x0 = (tile % tilesX) * TileSize, y0 = (tile / tilesX) * TileSize;
+                    for (int y = y0; y < std::min(y0 + TileSize, h); ++y)
+                        for (int x = x0; x < std::min(x0 + TileSize, w); ++x) {
+                            const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);
+                            Color& sum = sums[pixel];
+                            double& transmittance = transmittances[pixel];
+                            for (int s = s0; s < s1; ++s) {
+                                Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
+                                float jx = 0.5f, jy = 0.5f;
+                                if (rs.pixelJitter) {
+                                    jx = rng.uniform();
+                                    jy = rng.uniform();
+                                }
+                                Ray ray = scene.camera->generateRay(float(x) + jx, float(y) + jy);
+                                PathResult pr = marcher->radiance(ray, rng, ctx);
+                                if (!isFinite(pr.L) || !std::isfinite(pr.transmittance)) {
+                                    ++ctx.counters.nonFiniteSamples;  // dropped, never written
+                                    continue;
+                                }
+                                sum += pr.L;
+                                transmittance += pr.transmittance;
                             }
-                            Ray ray = scene.camera->generateRay(float(x) + jx, float(y) + jy);
-                            PathResult pr = marcher->radiance(ray, rng, ctx);
-                            if (!isFinite(pr.L) || !std::isfinite(pr.transmittance)) {
-                                ++ctx.counters.nonFiniteSamples;  // dropped, never written
-                                continue;
-                            }
-                            sum += pr.L;
-                            transmittance += pr.transmittance;
                         }
-                        float inv = 1.f / float(rs.spp);
-                        result.image.set(x, y, sum * inv, clamp(1.f - float(transmittance) * inv, 0.f, 1.f));
-                    }
-                tileCounters[size_t(tile)] += ctx.counters;
-                progress.tick();
-            }
-        }, tbb::simple_partitioner());
-    });
+                    tileCounters[size_t(tile)] += ctx.counters;
+                    if (!timed) progress.tick();
+                }
+            }, tbb::simple_partitioner());
+        });
+    };
+
+    int spp = 0;
+    if (!timed) {
+        renderPass(0, rs.spp);
+        spp = rs.spp;
+    } else {
+        // Whole passes of one sample per pixel while the next one is expected
+        // to finish within the budget (which also covers loading, measured
+        // from runStart); always at least one pass.
+        double lastPass = 0;
+        do {
+            auto p0 = std::chrono::steady_clock::now();
+            renderPass(spp, spp + 1);
+            ++spp;
+            auto now = std::chrono::steady_clock::now();
+            lastPass = std::chrono::duration<double>(now - p0).count();
+            double elapsed = std::chrono::duration<double>(now - runStart).count();
+            progress.set(elapsed / options.timeBudget);
+            if (elapsed + 1.05 * lastPass > options.timeBudget * 0.98) break;
+        } while (spp < (1 << 24));
+        progress.set(1.0);
+    }
+    result.spp = spp;
+    const float inv = 1.f / float(spp);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            size_t pixel = size_t(y) * size_t(w) + size_t(x);
+            result.image.set(x, y, sums[pixel] * inv, clamp(1.f - float(transmittances[pixel]) * inv, 0.f, 1.f));
+        }
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (const auto& c : tileCounters) result.counters += c;
     return result;

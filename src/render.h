@@ -1,7 +1,9 @@
 // The pipeline: scene -> (photons -> cache, later) -> marcher -> image.
 #pragma once
 
+#include <chrono>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "core/stats.h"
@@ -12,6 +14,11 @@ namespace vdbmarch {
 
 struct RenderOptions {
     bool progress = false;  // progress bar on stderr
+    // > 0: render whole passes of one sample per pixel until this many
+    // seconds (counted from runStart, so loading is included) are spent,
+    // instead of render.spp samples.
+    double timeBudget = 0;
+    std::optional<std::chrono::steady_clock::time_point> runStart;
 };
 
 struct RenderResult {
@@ -19,6 +26,7 @@ struct RenderResult {
     RenderCounters counters;
     double seconds = 0;   // rendering only
     int threads = 0;      // worker threads used
+    int spp = 0;          // samples per pixel actually rendered
 };
 
 // Renders the scene with scene.desc.render's method, spp, seed and threads.

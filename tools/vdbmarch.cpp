@@ -41,7 +41,8 @@ struct RenderArgs {
     // validated by the scene parser like any other key.
     int spp = 0, threads = 0;
     long long seed = 0;
-    double step = 0, exposure = 0;
+    double step = 0, exposure = 0, timeBudget = 0;
+    bool timeSet = false;
     bool sppSet = false, threadsSet = false, seedSet = false, stepSet = false, exposureSet = false;
     bool quiet = false, noProgress = false;
     std::vector<std::string> sets;
@@ -79,6 +80,10 @@ int runRender(const RenderArgs& a) {
     if (a.threadsSet && a.threads < 0) throw InputError(str("--threads ", a.threads, ": must be 0 (all cores) or more"));
     if (a.stepSet && !(a.step > 0 && std::isfinite(a.step)))
         throw InputError(str("--step ", a.step, ": must be a positive length in world units"));
+    if (a.timeSet && !(a.timeBudget > 0 && std::isfinite(a.timeBudget)))
+        throw InputError(str("--time ", a.timeBudget, ": must be a positive number of seconds"));
+    if (a.timeSet && a.sppSet)
+        throw InputError("--time and --spp both given: a render is budgeted either by samples or by seconds");
     if (a.sppSet) overrides.push_back(str("render.spp=", a.spp));
     if (a.seedSet) overrides.push_back(str("render.seed=", a.seed));
     if (a.threadsSet) overrides.push_back(str("render.threads=", a.threads));
@@ -99,6 +104,10 @@ int runRender(const RenderArgs& a) {
 
     RenderOptions options;
     options.progress = !a.quiet && !a.noProgress && isatty(STDERR_FILENO);
+    if (a.timeSet) {
+        options.timeBudget = a.timeBudget;
+        options.runStart = t0;
+    }
     RenderResult r = renderImage(*scene, options);
     const RenderCounters& c = r.counters;
     if (c.nonFiniteSamples > 0)
@@ -108,7 +117,8 @@ int runRender(const RenderArgs& a) {
         {"vdbmarch:version", VDBMARCH_VERSION},
         {"vdbmarch:source", desc.file},
         {"vdbmarch:method", desc.render.method},
-        {"vdbmarch:spp", std::to_string(desc.render.spp)},
+        {"vdbmarch:spp", std::to_string(r.spp)},
+        {"vdbmarch:timeBudget", a.timeSet ? str(a.timeBudget) : std::string("none")},
         {"vdbmarch:seed", std::to_string(desc.render.seed)},
         {"vdbmarch:step", str(scene->step)},
         {"vdbmarch:shadowStep", str(scene->shadowStep)},
@@ -124,7 +134,8 @@ int runRender(const RenderArgs& a) {
         s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"total", total}};
         s["threads"] = r.threads;
         s["method"] = desc.render.method;
-        s["spp"] = desc.render.spp;
+        s["spp"] = r.spp;
+        if (a.timeSet) s["time_budget"] = a.timeBudget;
         s["resolution"] = {r.image.width, r.image.height};
         s["step"] = scene->step;
         s["shadow_step"] = scene->shadowStep;
@@ -136,7 +147,7 @@ int runRender(const RenderArgs& a) {
     }
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (load %.3f s, total %.3f s) -> %s%s%s\n",
-                     r.image.width, r.image.height, desc.render.spp, desc.render.method.c_str(), double(scene->step),
+                     r.image.width, r.image.height, r.spp, desc.render.method.c_str(), double(scene->step),
                      r.seconds, loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
     return 0;
 }
@@ -182,6 +193,10 @@ int main(int argc, char** argv) {
     render->add_option("--method", ra.method, "Estimator: " + methods);
     auto flagSet = [](bool& b) { return [&b](const std::string&) { b = true; }; };
     render->add_option("--spp", ra.spp, "Samples per pixel")->each(flagSet(ra.sppSet));
+    render->add_option("--time", ra.timeBudget,
+                       "Time budget in seconds for the whole run, instead of --spp: whole passes of one sample "
+                       "per pixel while the next fits")
+        ->each(flagSet(ra.timeSet));
     render->add_option("--res", ra.res, "Resolution WIDTHxHEIGHT");
     render->add_option("--seed", ra.seed, "Random seed")->each(flagSet(ra.seedSet));
     render->add_option("--threads", ra.threads, "Worker threads (0 = all cores)")->each(flagSet(ra.threadsSet));

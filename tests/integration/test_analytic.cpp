@@ -156,3 +156,25 @@ TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
 
 }  // namespace
 }  // namespace vdbmarch::testing
+
+namespace vdbmarch::testing {
+namespace {
+
+// A time budget renders whole passes of one sample per pixel; the image is the
+// same, bit for bit, as a render of that many samples per pixel.
+TEST(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
+    std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
+    SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]"});
+    auto scene = buildScene(d);
+    RenderOptions timed;
+    timed.timeBudget = 0.5;
+    RenderResult a = renderImage(*scene, timed);
+    ASSERT_GE(a.spp, 1);
+    d.render.spp = a.spp;
+    RenderResult b = renderImage(*buildScene(d));
+    EXPECT_EQ(b.spp, a.spp);
+    EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), b.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
+}
+
+}  // namespace
+}  // namespace vdbmarch::testing
