@@ -21,6 +21,7 @@ struct ThreadContext {
     const Scene& scene;
     std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
     std::vector<Interval> intervals, shadowIntervals, scratch;
+    std::vector<MajorantSegment> majorants, scratchSegments;
     RenderCounters counters;
 };
 

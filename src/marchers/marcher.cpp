@@ -12,6 +12,7 @@ struct Entry {
 // The factory table: one line per method.
 const Entry kMarchers[] = {
     {"uniform", makeUniformMarcher},
+    {"reference", makeReferenceTracer},
 };
 }  // namespace
 

@@ -32,5 +32,6 @@ std::unique_ptr<Marcher> makeMarcher(const std::string& method, const Scene& sce
 
 // Constructors behind the factory table.
 std::unique_ptr<Marcher> makeUniformMarcher(const Scene& scene);
+std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene);
 
 }  // namespace vdbmarch

@@ -94,7 +94,8 @@ bool Light::sample(const Vec3& x, float u1, float u2, LightSample& s) const {
             float disc = b * b - (d2 - r2);
             s.dist = b - safeSqrt(disc);
             if (!(s.dist > 0)) s.dist = b;
-            s.L = mRadiance / uniformConePdf(cosMax);
+            s.pdf = uniformConePdf(cosMax);
+            s.L = mRadiance / s.pdf;
             return true;
         }
     }

@@ -13,6 +13,7 @@ struct LightSample {
     Vec3 wi;     // unit, from the shaded point towards the light
     float dist;  // distance to the light along wi (Infinity: directional)
     Color L;
+    float pdf = 0;  // solid-angle pdf of wi for area lights; 0 for delta lights
 };
 
 class Light {

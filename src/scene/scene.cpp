@@ -44,6 +44,16 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
                      "\") has emission but sigma_a = 0: emission enters as sigma_a L_e, so it is invisible"));
         scene->media.push_back(std::move(m));
     }
+    if (desc.render.method == "reference") {
+        bool deltaLight = false, glassWithMedium = false;
+        for (const auto& l : desc.lights) deltaLight = deltaLight || l.type != LightDesc::Type::Sphere;
+        for (const auto& s : desc.surfaces)
+            glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric && !s.interior.empty());
+        if (deltaLight && glassWithMedium)
+            warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
+                                "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
+                                "light in the reference; use sphere lights where the reference must converge"));
+    }
     if (desc.render.maxDepth > 1 && desc.render.method == "uniform")
         warn(str(desc.file, ": render.max_depth = ", desc.render.maxDepth,
                  ": the uniform marcher computes single scattering (direct light) only in this release"));

@@ -266,7 +266,7 @@ RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
                  "pixel_jitter", "exposure"});
     RenderSettings s;
-    s.method = r.choice("method", s.method, {"uniform"});
+    s.method = r.choice("method", s.method, {"uniform", "reference"});
     s.spp = r.integer("spp", s.spp, 1, 1 << 24);
     if (r.has("step")) s.step = float(r.positive("step", 1));
     if (r.has("shadow_step")) s.shadowStep = float(r.positive("shadow_step", 1));

@@ -13,6 +13,12 @@
 
 namespace vdbmarch {
 
+// A piece of a ray with an upper bound on the density over it (a local
+// majorant from the VDB tree, for delta and ratio tracking).
+struct MajorantSegment {
+    float t0, t1, maxDensity;
+};
+
 class MediumQuery {
 public:
     virtual ~MediumQuery() = default;
@@ -28,6 +34,10 @@ public:
     // density over [tMin, tMax] and returns true. Gridded media return false
     // and are marched.
     virtual bool densityIntegral(const Ray& r, float tMin, float tMax, float& integral) { return false; }
+    // Appends, in increasing order, segments covering every point of [tMin,
+    // tMax] where the density may be non-zero, each with an upper bound of the
+    // density on it: per 8^3 block for VDB grids, constant for homogeneous media.
+    virtual void majorantSegments(const Ray& r, float tMin, float tMax, std::vector<MajorantSegment>& out) = 0;
 };
 
 class Medium {

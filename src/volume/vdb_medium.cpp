@@ -167,6 +167,7 @@ struct PaddedBlocks {
     // Per block, the cells (0..7 per axis) whose trilinear stencil touches a
     // non-zero value: lo in bits 0-11, hi (exclusive, 1..8) in bits 12-23.
     std::vector<uint32_t> tightBox;
+    std::vector<float> blockMax;  // largest value in each padded block: a local majorant
 
     static uint32_t computeTightBox(const float* v) {
         int lo[3] = {8, 8, 8}, hi[3] = {0, 0, 0};
@@ -204,6 +205,7 @@ struct PaddedBlocks {
         values.assign(origins.size() * Size, 0.f);
         std::vector<char> nonEmpty(origins.size(), 0);
         std::vector<uint32_t> boxes(origins.size(), 0);
+        std::vector<float> maxima(origins.size(), 0.f);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
             auto acc = grid.getConstAccessor();
             for (size_t b = r.begin(); b != r.end(); ++b) {
@@ -219,6 +221,7 @@ struct PaddedBlocks {
                         }
                 nonEmpty[b] = any;
                 if (any) boxes[b] = computeTightBox(dst);
+                maxima[b] = *std::max_element(dst, dst + Size);
             }
         });
         // Compact: drop all-zero blocks.
@@ -228,6 +231,7 @@ struct PaddedBlocks {
             if (kept != b) std::copy_n(&values[b * Size], Size, &values[kept * Size]);
             index.setValue(origins[b], int32_t(kept + 1));
             tightBox.push_back(boxes[b]);
+            blockMax.push_back(maxima[b]);
             ++kept;
         }
         values.resize(kept * Size);
@@ -243,8 +247,13 @@ public:
     float density(const Vec3& p) override;
     float emission(const Vec3& p) override;
     void activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) override;
+    void majorantSegments(const Ray& r, float tMin, float tMax, std::vector<MajorantSegment>& out) override;
 
 private:
+    // Calls visit(t0, t1, block) for each block's tight box along the ray.
+    template <typename Visit>
+    void walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit);
+
     const VdbMedium& mMedium;
     openvdb::FloatGrid::ConstAccessor mDensity;
     std::unique_ptr<openvdb::FloatGrid::ConstAccessor> mEmission;
@@ -376,7 +385,8 @@ float VdbQuery::emission(const Vec3& p) {
     return sampleTrilinear(*mEmission, mMedium.mEmissionW2I.point(p)) * mMedium.mEmissionScale;
 }
 
-void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) {
+template <typename Visit>
+void VdbQuery::walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit) {
     if (mMedium.mMaxDensity <= 0) return;
     // The index-space ray keeps the world parameter t: its direction is the
     // (unnormalised) image of the world direction.
@@ -403,12 +413,6 @@ void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector
     // the blocks with a 3D-DDA on the 8-voxel lattice and keep only the part
     // of the ray inside each block's tight box of non-zero stencils.
     const openvdb::Vec3d inv(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
-    auto emit = [&](double a, double b) {
-        float fa = float(a), fb = float(b);
-        if (!(fb > fa)) return;
-        if (!out.empty() && fa <= out.back().t1) out.back().t1 = std::max(out.back().t1, fb);
-        else out.push_back({fa, fb});
-    };
     for (const auto& span : mSpans) {
         double s0 = std::max(span.t0, t0), s1 = std::min(span.t1, t1);
         if (!(s1 > s0)) continue;
@@ -439,13 +443,33 @@ void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector
                     a = std::max(a, ta);
                     b = std::min(b, tb);
                 }
-                emit(a, b);
+                if (b > a) visit(a, b, size_t(id - 1));
             }
             tCur = tNext[axis];
             cell[axis] += step[axis];
             tNext[axis] += tDelta[axis];
         }
     }
+}
+
+void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) {
+    walkBlocks(r, tMin, tMax, [&](double a, double b, size_t) {
+        float fa = float(a), fb = float(b);
+        if (!(fb > fa)) return;
+        if (!out.empty() && fa <= out.back().t1) out.back().t1 = std::max(out.back().t1, fb);
+        else out.push_back({fa, fb});
+    });
+}
+
+void VdbQuery::majorantSegments(const Ray& r, float tMin, float tMax, std::vector<MajorantSegment>& out) {
+    const auto& maxima = mMedium.mBlocks.blockMax;
+    const float scale = mMedium.mScale;
+    walkBlocks(r, tMin, tMax, [&](double a, double b, size_t block) {
+        float fa = float(a), fb = float(b), m = maxima[block] * scale;
+        if (!(fb > fa)) return;
+        if (!out.empty() && fa <= out.back().t1 && out.back().maxDensity == m) out.back().t1 = std::max(out.back().t1, fb);
+        else out.push_back({fa, fb, m});
+    });
 }
 
 }  // namespace
