@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "core/sampling.h"
@@ -259,6 +260,50 @@ TEST(Reference, AgreesWithTheUniformMarcherForSingleScattering) {
             EXPECT_NEAR(d.mean, 0.0, 4 * d.stdError + 5e-3 * b.mean) << "region " << q << " channel " << c;
         }
     }
+}
+
+}  // namespace
+}  // namespace vdbmarch::testing
+
+namespace vdbmarch::testing {
+namespace {
+
+// Convergence: the reference is unbiased with finite variance, so its MSE
+// against a high-sample image falls as 1/spp: doubling spp divides it by
+// (1/n + 1/N) / (1/(2n) + 1/N) (N: the high image's spp, whose own noise adds
+// 1/N). The ratio's tolerance is 4 standard errors from the measured spread of
+// the per-pixel squared errors (delta method).
+TEST(Reference, MseHalvesWhenSamplesDouble) {
+    std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
+    auto render = [&](int spp, int seed) {
+        SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[32,24]", "render.method=reference",
+                                                "render.max_depth=4", str("render.spp=", spp), str("render.seed=", seed)});
+        return renderImage(*buildScene(d)).image;
+    };
+    const int N = 1024, n = 16;
+    Image high = render(N, 100), a = render(n, 1), b = render(2 * n, 2);
+    auto mse = [&](const Image& img, double& se) {
+        double s = 0, s2 = 0;
+        size_t m = 0;
+        for (size_t i = 0; i < img.rgba.size(); ++i) {
+            if (i % 4 == 3) continue;
+            double e = double(img.rgba[i]) - double(high.rgba[i]);
+            s += e * e;
+            s2 += e * e * e * e;
+            ++m;
+        }
+        double mean = s / double(m);
+        se = std::sqrt(std::max(0.0, s2 / double(m) - mean * mean) / double(m - 1));
+        return mean;
+    };
+    double seA, seB;
+    double mseA = mse(a, seA), mseB = mse(b, seB);
+    double ratio = mseA / mseB;
+    double expected = (1.0 / n + 1.0 / N) / (1.0 / (2 * n) + 1.0 / N);
+    double relSe = std::sqrt((seA / mseA) * (seA / mseA) + (seB / mseB) * (seB / mseB));
+    EXPECT_NEAR(ratio, expected, 4 * relSe * expected) << "MSE " << mseA << " -> " << mseB;
+    EXPECT_LT(relSe, 0.25);  // the test has power: the ratio is resolved to better than 25%
+    std::printf("MSE %g -> %g, ratio %g (expected %g, relative SE %g)\n", mseA, mseB, ratio, expected, relSe);
 }
 
 }  // namespace
