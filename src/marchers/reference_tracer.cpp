@@ -54,6 +54,19 @@ private:
     // Extinction used for tracking: channel c, or (grey media) channel 0.
     static float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[channel < 0 ? 0 : channel]; }
 
+    // One medium's majorant segments: local (per VDB block) by default; with
+    // render.majorant = "global", the grid's maximum over its whole bounding
+    // box, the classic baseline the local majorants are benchmarked against.
+    void mediumMajorants(ThreadContext& ctx, int mi, const Ray& r, float tEnd, std::vector<MajorantSegment>& out) const {
+        const Medium& m = *mScene.media[size_t(mi)];
+        if (!mScene.desc.render.globalMajorant || m.minVoxelSize() == 0) {
+            ctx.queries[size_t(mi)]->majorantSegments(r, 0.f, tEnd, out);
+            return;
+        }
+        float t0 = 0, t1 = tEnd;
+        if (m.maxDensity() > 0 && m.worldBounds().intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1, m.maxDensity()});
+    }
+
     // Combined majorant of the region's media along [0, tEnd) for `channel`;
     // max over channels when channel < 0 (ratio tracking of all channels).
     void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel, bool maxOverChannels,
@@ -67,7 +80,7 @@ private:
         };
         if (media.size() == 1) {
             float k = coefficient(media[0]);
-            ctx.queries[size_t(media[0])]->majorantSegments(r, 0.f, tEnd, out);
+            mediumMajorants(ctx, media[0], r, tEnd, out);
             for (auto& s : out) s.maxDensity *= k;
             return;
         }
@@ -77,7 +90,7 @@ private:
         std::vector<std::pair<size_t, size_t>> ranges;
         for (int mi : media) {
             size_t first = all.size();
-            ctx.queries[size_t(mi)]->majorantSegments(r, 0.f, tEnd, all);
+            mediumMajorants(ctx, mi, r, tEnd, all);
             float k = coefficient(mi);
             for (size_t i = first; i < all.size(); ++i) {
                 all[i].maxDensity *= k;
@@ -150,7 +163,7 @@ private:
             if (!(kMax > 0)) continue;
             MediumQuery& q = *ctx.queries[size_t(mi)];
             ctx.scratchSegments.clear();
-            q.majorantSegments(r, 0.f, tEnd, ctx.scratchSegments);
+            mediumMajorants(ctx, mi, r, tEnd, ctx.scratchSegments);
             for (const auto& seg : ctx.scratchSegments) {
                 float sigmaMaj = seg.maxDensity * kMax;
                 if (!(sigmaMaj > 0)) continue;
@@ -236,17 +249,17 @@ private:
             int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
             float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
 
-            // Delta tracking to the next real collision, or to tEnd.
+            // Delta tracking to the next real collision, or to tEnd. `track`
+            // handles one majorant segment; it returns false once the path
+            // scattered or was absorbed.
             bool scattered = false;
-            regionMajorants(ctx, region, ray, tEnd, channel, false, ctx.majorants);
-            for (const auto& seg : ctx.majorants) {
-                if (scattered || isBlack(beta)) break;
+            auto track = [&](const MajorantSegment& seg) {
                 const float sigmaMaj = seg.maxDensity;
-                if (!(sigmaMaj > 0)) continue;
+                if (!(sigmaMaj > 0)) return true;
                 double t = seg.t0;
                 while (true) {
                     t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
-                    if (t >= seg.t1) break;
+                    if (t >= seg.t1) return true;
                     Vec3 x = ray.at(t);
                     evalMedia(ctx, region, x, mp);
                     ++ctx.counters.marchSamples;
@@ -256,38 +269,49 @@ private:
                     float u = rng.uniform() * sigmaMaj;
                     if (u < sa) {
                         beta = Color(0);  // absorbed
-                        break;
+                        return false;
                     }
-                    if (u < sa + ss) {
-                        // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
-                        beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
-                        ++depth;
-                        if (depth > maxDepth) {
-                            beta = Color(0);
-                            break;
-                        }
-                        L += beta * nextEvent(ctx, region, x, ray.d, &mp, nullptr, Color(0), rng);
-                        // Sample the phase mixture: pick a medium by sigma_s, then its lobe.
-                        float total = 0;
-                        for (int i = 0; i < mp.count; ++i) total += average(mp.sigmaS[i]);
-                        float pick = rng.uniform() * total;
-                        int k = 0;
-                        while (k + 1 < mp.count && pick >= average(mp.sigmaS[k])) pick -= average(mp.sigmaS[k++]);
-                        float cosT = sampleHgCosTheta(rng.uniform(), mp.g[k]);
-                        Vec3 wi = directionAround(ray.d, cosT, rng.uniform());
-                        float c = dot(wi, ray.d);
-                        float pdf = hgMix(mp, c);
-                        // f / pdf per channel (1 for a single medium)
-                        beta *= phaseMixture(mp, c) / pdf;
-                        lastPdf = pdf;
-                        specular = false;
-                        lastPoint = x;
-                        ray = Ray{x, wi};
-                        scattered = true;
-                        break;
+                    if (u >= sa + ss) continue;  // null collision
+                    // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
+                    beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+                    ++depth;
+                    if (depth > maxDepth) {
+                        beta = Color(0);
+                        return false;
                     }
-                    // Null collision: continue.
+                    L += beta * nextEvent(ctx, region, x, ray.d, &mp, nullptr, Color(0), rng);
+                    // Sample the phase mixture: pick a medium by sigma_s, then its lobe.
+                    float total = 0;
+                    for (int i = 0; i < mp.count; ++i) total += average(mp.sigmaS[i]);
+                    float pick = rng.uniform() * total;
+                    int k = 0;
+                    while (k + 1 < mp.count && pick >= average(mp.sigmaS[k])) pick -= average(mp.sigmaS[k++]);
+                    float cosT = sampleHgCosTheta(rng.uniform(), mp.g[k]);
+                    Vec3 wi = directionAround(ray.d, cosT, rng.uniform());
+                    float c = dot(wi, ray.d);
+                    float pdf = hgMix(mp, c);
+                    beta *= phaseMixture(mp, c) / pdf;  // f / pdf per channel (1 for one medium)
+                    lastPdf = pdf;
+                    specular = false;
+                    lastPoint = x;
+                    ray = Ray{x, wi};
+                    scattered = true;
+                    return false;
                 }
+            };
+            const auto& regionMedia = scene.regions[size_t(region)].media;
+            if (regionMedia.size() == 1 && !scene.desc.render.globalMajorant) {
+                // Lazily: blocks past the first real collision are never visited.
+                const Medium& m = *scene.media[size_t(regionMedia[0])];
+                const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
+                const Ray segmentRay = ray;  // `track` replaces ray when it scatters
+                ctx.queries[size_t(regionMedia[0])]->forEachMajorant(segmentRay, 0.f, tEnd, [&](const MajorantSegment& s) {
+                    return track({s.t0, s.t1, s.maxDensity * k});
+                });
+            } else if (!regionMedia.empty()) {
+                regionMajorants(ctx, region, ray, tEnd, channel, false, ctx.majorants);
+                for (const auto& seg : ctx.majorants)
+                    if (!track(seg)) break;
             }
             if (isBlack(beta)) return {channelOnly(L, channel), 0.f};
             if (scattered) {

@@ -72,6 +72,7 @@ struct RenderSettings {
     int maxSurfaceBounces = 32;
     bool pixelJitter = true;  // false: one ray through each pixel centre
     float exposure = 0;       // PNG preview, stops
+    bool globalMajorant = false;  // reference: one majorant per grid (benchmarks only)
 };
 
 struct SceneDesc {

@@ -264,7 +264,7 @@ SurfaceDesc parseSurface(const JsonReader& r) {
 
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
-                 "pixel_jitter", "exposure"});
+                 "pixel_jitter", "exposure", "majorant"});
     RenderSettings s;
     s.method = r.choice("method", s.method, {"uniform", "reference"});
     s.spp = r.integer("spp", s.spp, 1, 1 << 24);
@@ -281,6 +281,7 @@ RenderSettings parseRender(const JsonReader& r) {
     s.maxSurfaceBounces = r.integer("max_surface_bounces", s.maxSurfaceBounces, 0, 1000);
     s.pixelJitter = r.boolean("pixel_jitter", s.pixelJitter);
     s.exposure = float(r.numberIn("exposure", 0, -64, 64));
+    s.globalMajorant = r.choice("majorant", "local", {"local", "global"}) == "global";
     return s;
 }
 

@@ -19,9 +19,10 @@ public:
         if (mBounds.intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1});
     }
 
-    void majorantSegments(const Ray& r, float tMin, float tMax, std::vector<MajorantSegment>& out) override {
+    void forEachMajorant(const Ray& r, float tMin, float tMax,
+                         const std::function<bool(const MajorantSegment&)>& visit) override {
         float t0 = tMin, t1 = tMax;
-        if (!mBounded || (mBounds.intersect(r, t0, t1) && t1 > t0)) out.push_back({t0, t1, 1.f});
+        if (!mBounded || (mBounds.intersect(r, t0, t1) && t1 > t0)) visit({t0, t1, 1.f});
     }
     bool densityIntegral(const Ray& r, float tMin, float tMax, float& integral) override {
         integral = 0;

@@ -247,10 +247,12 @@ public:
     float density(const Vec3& p) override;
     float emission(const Vec3& p) override;
     void activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) override;
-    void majorantSegments(const Ray& r, float tMin, float tMax, std::vector<MajorantSegment>& out) override;
+    void forEachMajorant(const Ray& r, float tMin, float tMax,
+                         const std::function<bool(const MajorantSegment&)>& visit) override;
 
 private:
-    // Calls visit(t0, t1, block) for each block's tight box along the ray.
+    // Calls visit(t0, t1, block) for each block's tight box along the ray,
+    // in increasing t, until visit returns false.
     template <typename Visit>
     void walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit);
 
@@ -443,7 +445,7 @@ void VdbQuery::walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit) {
                     a = std::max(a, ta);
                     b = std::min(b, tb);
                 }
-                if (b > a) visit(a, b, size_t(id - 1));
+                if (b > a && !visit(a, b, size_t(id - 1))) return;
             }
             tCur = tNext[axis];
             cell[axis] += step[axis];
@@ -455,21 +457,35 @@ void VdbQuery::walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit) {
 void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) {
     walkBlocks(r, tMin, tMax, [&](double a, double b, size_t) {
         float fa = float(a), fb = float(b);
-        if (!(fb > fa)) return;
+        if (!(fb > fa)) return true;
         if (!out.empty() && fa <= out.back().t1) out.back().t1 = std::max(out.back().t1, fb);
         else out.push_back({fa, fb});
+        return true;
     });
 }
 
-void VdbQuery::majorantSegments(const Ray& r, float tMin, float tMax, std::vector<MajorantSegment>& out) {
+void VdbQuery::forEachMajorant(const Ray& r, float tMin, float tMax,
+                               const std::function<bool(const MajorantSegment&)>& visit) {
     const auto& maxima = mMedium.mBlocks.blockMax;
     const float scale = mMedium.mScale;
+    // Adjacent blocks with the same maximum are merged before visiting.
+    MajorantSegment pending{0, 0, -1};
+    bool stopped = false;
     walkBlocks(r, tMin, tMax, [&](double a, double b, size_t block) {
         float fa = float(a), fb = float(b), m = maxima[block] * scale;
-        if (!(fb > fa)) return;
-        if (!out.empty() && fa <= out.back().t1 && out.back().maxDensity == m) out.back().t1 = std::max(out.back().t1, fb);
-        else out.push_back({fa, fb, m});
+        if (!(fb > fa)) return true;
+        if (pending.maxDensity == m && fa <= pending.t1) {
+            pending.t1 = std::max(pending.t1, fb);
+            return true;
+        }
+        if (pending.maxDensity >= 0 && !visit(pending)) {
+            stopped = true;
+            return false;
+        }
+        pending = {fa, fb, m};
+        return true;
     });
+    if (!stopped && pending.maxDensity >= 0) visit(pending);
 }
 
 }  // namespace
