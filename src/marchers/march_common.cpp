@@ -131,34 +131,15 @@ Color opticalDepth(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng
 }  // namespace
 
 Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const Vec3& wi, float dist, Rng& rng) {
-    const Scene& scene = ctx.scene;
     ++ctx.counters.shadowRays;
-    Ray r{p, wi};
-    float remaining = dist;
     Color tau(0);
     // exp(-30) ~ 1e-13: beyond that depth the light is numerically gone.
     const float cutoff = 30.f;
-    for (int crossing = 0; crossing <= scene.desc.render.maxSurfaceBounces; ++crossing) {
-        // The target sphere light sits at `remaining`; stop just short of it.
-        float tLimit = std::isfinite(remaining) ? remaining * (1 - 1e-4f) : Infinity;
-        SurfaceHit h;
-        bool hit = scene.surfaceSet->intersect(r, 0.f, tLimit, h);
-        float tLight;
-        if (intersectSphereLights(scene, r, 1e-4f * scene.sceneScale, hit ? h.t : tLimit, tLight) >= 0)
-            return Color(0);
-        float segEnd = hit ? h.t : remaining;
-        tau += opticalDepth(ctx, region, r, segEnd, rng, cutoff - minComponent(tau));
-        if (minComponent(tau) > cutoff) return Color(0);
-        if (!hit) return exp(-tau);
-        const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
-        // Glass refracts and diffuse surfaces are opaque: a straight shadow
-        // ray cannot pass them (photons carry that light in a later stage).
-        if (s.material.type != MaterialDesc::Type::Interface) return Color(0);
-        region = dot(r.d, h.n) < 0 ? s.interiorRegion : s.exteriorRegion;
-        r.o = offsetRayOrigin(scene, h.p, h.n, r.d);
-        if (std::isfinite(remaining)) remaining -= h.t;
-    }
-    return Color(0);
+    bool reached = walkShadowRay(ctx.scene, region, Ray{p, wi}, dist, [&](int reg, const Ray& r, float tEnd) {
+        tau += opticalDepth(ctx, reg, r, tEnd, rng, cutoff - minComponent(tau));
+        return !(minComponent(tau) > cutoff);
+    });
+    return reached ? exp(-tau) : Color(0);
 }
 
 Color directInScattering(ThreadContext& ctx, int region, const Vec3& p, const Vec3& rayDir, const MediumPoint& mp,

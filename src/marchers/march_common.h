@@ -74,4 +74,32 @@ int regionAtRayStart(const Scene& scene, const Ray& r);
 // Closest sphere light hit in (tMin, tMax); returns the light index or -1.
 int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tMax, float& t);
 
+// Walks a shadow ray from r.o over distance `dist` (Infinity: to the
+// environment), starting in `region`: calls segment(region, ray, tEnd) for
+// each piece between surfaces; interfaces are crossed (the region changes),
+// any other surface or a sphere light blocks. Returns false when blocked or
+// when `segment` returned false.
+template <typename Segment>
+bool walkShadowRay(const Scene& scene, int region, Ray r, float dist, Segment&& segment) {
+    float remaining = dist;
+    for (int crossing = 0; crossing <= scene.desc.render.maxSurfaceBounces; ++crossing) {
+        // A target sphere light sits at `remaining`; stop just short of it.
+        float tLimit = std::isfinite(remaining) ? remaining * (1 - 1e-4f) : Infinity;
+        SurfaceHit h;
+        bool hit = scene.surfaceSet->intersect(r, 0.f, tLimit, h);
+        float tLight;
+        if (intersectSphereLights(scene, r, 1e-4f * scene.sceneScale, hit ? h.t : tLimit, tLight) >= 0) return false;
+        if (!segment(region, r, hit ? h.t : remaining)) return false;
+        if (!hit) return true;
+        const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+        // Glass refracts and diffuse surfaces are opaque: a straight shadow
+        // ray cannot pass them.
+        if (s.material.type != MaterialDesc::Type::Interface) return false;
+        region = dot(r.d, h.n) < 0 ? s.interiorRegion : s.exteriorRegion;
+        r.o = offsetRayOrigin(scene, h.p, h.n, r.d);
+        if (std::isfinite(remaining)) remaining -= h.t;
+    }
+    return false;
+}
+
 }  // namespace vdbmarch

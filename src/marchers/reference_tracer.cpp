@@ -117,25 +117,11 @@ private:
     Color transmittance(ThreadContext& ctx, int region, Ray r, float dist, Rng& rng) const {
         ++ctx.counters.shadowRays;
         Color T(1);
-        float remaining = dist;
-        for (int crossing = 0; crossing <= mScene.desc.render.maxSurfaceBounces; ++crossing) {
-            float tLimit = std::isfinite(remaining) ? remaining * (1 - 1e-4f) : Infinity;
-            SurfaceHit h;
-            bool hit = mScene.surfaceSet->intersect(r, 0.f, tLimit, h);
-            float tl;
-            if (intersectSphereLights(mScene, r, 1e-4f * mScene.sceneScale, hit ? h.t : tLimit, tl) >= 0)
-                return Color(0);
-            float segEnd = hit ? h.t : remaining;
-            T *= segmentTransmittance(ctx, region, r, segEnd, rng);
-            if (isBlack(T)) return T;
-            if (!hit) return T;
-            const SurfaceInfo& s = mScene.surfaces[size_t(h.surface)];
-            if (s.material.type != MaterialDesc::Type::Interface) return Color(0);
-            region = dot(r.d, h.n) < 0 ? s.interiorRegion : s.exteriorRegion;
-            r.o = offsetRayOrigin(mScene, h.p, h.n, r.d);
-            if (std::isfinite(remaining)) remaining -= h.t;
-        }
-        return Color(0);
+        bool reached = walkShadowRay(mScene, region, r, dist, [&](int reg, const Ray& seg, float tEnd) {
+            T *= segmentTransmittance(ctx, reg, seg, tEnd, rng);
+            return !isBlack(T);
+        });
+        return reached ? T : Color(0);
     }
 
     Color segmentTransmittance(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng) const {

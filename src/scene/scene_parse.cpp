@@ -32,14 +32,8 @@ void lineColumn(const std::string& text, size_t byte, size_t& line, size_t& col,
     } else if (!text.empty() && isWordChar(text[pos])) {
         while (pos > 0 && isWordChar(text[pos - 1])) --pos;
     }
-    line = 1;
-    size_t lineStart = 0;
-    for (size_t i = 0; i < pos && i < text.size(); ++i)
-        if (text[i] == '\n') {
-            ++line;
-            lineStart = i + 1;
-        }
-    col = pos - lineStart + 1;
+    lineAndColumn(text, pos, line, col);
+    size_t lineStart = pos + 1 - col;
     size_t lineEnd = text.find('\n', lineStart);
     excerpt = text.substr(lineStart, lineEnd == std::string::npos ? std::string::npos : lineEnd - lineStart);
     if (excerpt.size() > 120) excerpt = excerpt.substr(0, 120) + "...";
