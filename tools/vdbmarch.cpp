@@ -8,7 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <algorithm>
 #include <iostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -18,6 +20,7 @@
 #include "image/exr_io.h"
 #include "image/metrics.h"
 #include "image/png_io.h"
+#include "bench.h"
 #include "marchers/marcher.h"
 #include "render.h"
 #include "scene/auto_scene.h"
@@ -164,6 +167,59 @@ int runCompare(const std::string& a, const std::string& b, const std::string& di
     return 0;
 }
 
+struct BenchArgs {
+    std::string scene, methods = "uniform,reference", budgets = "1,2,4,8", out, reference, res;
+    bool seconds = false;
+    int referenceSpp = 256, repeats = 1;
+    std::vector<std::string> sets;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    for (std::string item; std::getline(ss, item, ',');)
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+int runBenchCommand(const BenchArgs& a) {
+    std::vector<std::string> overrides = a.sets;
+    if (!a.res.empty()) {
+        int w = 0, h = 0;
+        char x = 0, extra = 0;
+        if (std::sscanf(a.res.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+            throw InputError(str("--res ", a.res, ": expected WIDTHxHEIGHT, e.g. 320x240"));
+        overrides.push_back(str("camera.resolution=[", w, ",", h, "]"));
+    }
+    SceneDesc desc = endsWith(a.scene, ".vdb") ? loadAutoScene(a.scene, overrides) : loadSceneFile(a.scene, overrides);
+    BenchOptions o;
+    o.methods = splitList(a.methods);
+    for (const auto& m : o.methods) {
+        auto names = marcherNames();
+        if (std::find(names.begin(), names.end(), m) == names.end())
+            throw InputError(str("--methods: unknown method \"", m, "\""));
+    }
+    for (const auto& b : splitList(a.budgets)) {
+        char* end = nullptr;
+        double v = std::strtod(b.c_str(), &end);
+        if (*end != 0) throw InputError(str("--budgets: \"", b, "\" is not a number"));
+        o.budgets.push_back(v);
+    }
+    if (a.referenceSpp < 2) throw InputError(str("--reference-spp ", a.referenceSpp, ": must be at least 2"));
+    if (a.repeats < 1) throw InputError(str("--repeats ", a.repeats, ": must be at least 1"));
+    o.budgetSeconds = a.seconds;
+    o.outDir = a.out;
+    o.referencePath = a.reference;
+    o.referenceSpp = a.referenceSpp;
+    o.repeats = a.repeats;
+    BenchResult r = runBench(desc, o);
+    std::printf("reference: %s", r.referenceImage.c_str());
+    if (r.referenceNoiseRmse > 0) std::printf(" (estimated noise RMSE %.5g)", r.referenceNoiseRmse);
+    std::printf("\nwrote %s, %s%s%s\n", r.csvPath.c_str(), r.tablePath.c_str(), r.plotPath.empty() ? "" : ", ",
+                r.plotPath.c_str());
+    return 0;
+}
+
 int runInfo(const std::string& file) {
     for (const auto& g : listVdbGrids(file)) std::printf("grid %s\n", g.c_str());
     VdbGridSummary s = summarizeVdb(file, "");
@@ -215,6 +271,19 @@ int main(int argc, char** argv) {
     compare->add_option("reference", cb, "Reference image (.exr)")->required();
     compare->add_option("--diff", cdiff, "Write a false-colour difference PNG");
 
+    BenchArgs ba;
+    CLI::App* bench = app.add_subcommand("bench", "Run time against error: methods x budgets against a reference");
+    bench->add_option("scene", ba.scene, "Scene .json or .vdb")->required();
+    bench->add_option("-o,--output", ba.out, "Output folder (bench.csv, bench.md, bench.png, cached reference)")->required();
+    bench->add_option("--methods", ba.methods, "Comma-separated methods (default uniform,reference)");
+    bench->add_option("--budgets", ba.budgets, "Comma-separated budgets: spp, or seconds with --seconds");
+    bench->add_flag("--seconds", ba.seconds, "Budgets are seconds (whole passes within the time)");
+    bench->add_option("--reference", ba.reference, "Reference EXR (default: render one with the reference method)");
+    bench->add_option("--reference-spp", ba.referenceSpp, "Samples per pixel of a rendered reference (default 256)");
+    bench->add_option("--repeats", ba.repeats, "Runs per point; the median time is kept (default 1)");
+    bench->add_option("--res", ba.res, "Resolution WIDTHxHEIGHT");
+    bench->add_option("--set", ba.sets, "Override a scene key: key.path=value, repeatable");
+
     std::string infoFile;
     CLI::App* info = app.add_subcommand("info", "List the grids of a .vdb file and summarise its density grid");
     info->add_option("file", infoFile, "VDB file")->required();
@@ -230,6 +299,7 @@ int main(int argc, char** argv) {
         if (*render) return runRender(ra);
         if (*compare) return runCompare(ca, cb, cdiff);
         if (*info) return runInfo(infoFile);
+        if (*bench) return runBenchCommand(ba);
     } catch (const InputError& e) {
         std::fprintf(stderr, "vdbmarch: error: %s\n", e.what());
         return 1;
