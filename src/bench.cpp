@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include "image/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
+#include "core/transform.h"
 #include "render.h"
 
 namespace vdbmarch {
@@ -65,11 +67,47 @@ PowerFit fit(const std::vector<BenchRow>& rows) {
     return f;
 }
 
+// The external peer: OpenVDB's vdb_render, single scattering, for scenes it
+// can express (one VDB medium without transform or emission, isotropic, one
+// directional light, no surfaces, black background, perspective camera). The
+// budget is its step (and shadow step) in voxels. Mapping derived and checked
+// in bench/vdb_render_notes.md: per-voxel coefficients = sigma * h, light
+// colour = irradiance / (4 pi), -fov is horizontal, -light points at the light.
+std::string vdbRenderCommand(const SceneDesc& d, const Scene& scene, double stepVoxels, const std::string& out) {
+    auto refuse = [&](const std::string& why) {
+        throw InputError(str(d.file, ": method vdb_render cannot render this scene: ", why));
+    };
+    if (d.media.size() != 1 || d.media[0].type != MediumDesc::Type::Vdb) refuse("it needs exactly one vdb medium");
+    const MediumDesc& m = d.media[0];
+    if (m.hasEmission) refuse("emission");
+    if (m.g != 0) refuse(str("g = ", m.g, " (vdb_render is isotropic)"));
+    if (!Transform(m.transform).isIdentity()) refuse("a medium transform");
+    if (d.lights.size() != 1 || d.lights[0].type != LightDesc::Type::Directional) refuse("it needs exactly one directional light");
+    if (!d.surfaces.empty()) refuse("surfaces");
+    if (!isBlack(d.background)) refuse("a non-black background");
+    if (d.camera.type != CameraDesc::Type::Perspective) refuse("an orthographic camera");
+    const double h = scene.media[0]->minVoxelSize();
+    const CameraDesc& c = d.camera;
+    double hfov = 2 * std::atan(std::tan(double(radians(c.fovDeg)) / 2) * c.width / c.height) * 180 / M_PI;
+    Vec3 toLight = -d.lights[0].direction;
+    Color col = d.lights[0].irradiance / (4 * Pi);
+    return str("vdb_render '", m.file, "' '", out, "' -name '", m.grid, "' -res ", c.width, "x", c.height, " -translate ",
+               c.position.x, ",", c.position.y, ",", c.position.z, " -lookat ", c.lookAt.x, ",", c.lookAt.y, ",",
+               c.lookAt.z, " -up ", c.up.x, ",", c.up.y, ",", c.up.z, " -fov ", hfov, " -gain 0 -cutoff 1e-10",
+               " -scatter ", m.sigma_s.x * m.densityScale * h, ",", m.sigma_s.y * m.densityScale * h, ",",
+               m.sigma_s.z * m.densityScale * h, " -absorb ", m.sigma_a.x * m.densityScale * h, ",",
+               m.sigma_a.y * m.densityScale * h, ",", m.sigma_a.z * m.densityScale * h, " -light ", toLight.x, ",",
+               toLight.y, ",", toLight.z, ",", col.x, ",", col.y, ",", col.z, " -step ", stepVoxels, " -shadowstep ",
+               stepVoxels, " -compression none -cpus ", d.render.threads, " >/dev/null 2>&1");
+}
+
 }  // namespace
 
 BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     if (o.methods.empty()) throw InputError("bench: --methods is empty");
     if (o.budgets.empty()) throw InputError("bench: --budgets is empty");
+    for (double b : o.vdbRenderSteps)
+        if (!(b > 0)) throw InputError(str("bench: vdb_render step ", b, " must be positive"));
     for (double b : o.budgets)
         if (!(b > 0) || (!o.budgetSeconds && b != std::floor(b)))
             throw InputError(str("bench: budget ", b, " must be a positive ", o.budgetSeconds ? "number of seconds" : "whole number of samples"));
@@ -114,8 +152,28 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     }
 
     for (const auto& method : o.methods) {
-        for (double budget : o.budgets) {
+        for (double budget : method == "vdb_render" ? o.vdbRenderSteps : o.budgets) {
             SceneDesc d = baseScene;
+            if (method == "vdb_render") {
+                // Budget = step in voxels; time = the whole command (load + render + write).
+                auto scene = buildScene(d);
+                std::string out = o.outDir + str("/vdb_render_step", budget, ".exr");
+                std::string cmd = vdbRenderCommand(d, *scene, budget, out);
+                std::vector<double> times;
+                for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
+                    auto t0 = std::chrono::steady_clock::now();
+                    if (std::system(cmd.c_str()) != 0)
+                        throw IoError(str("bench: vdb_render failed (is libopenvdb-tools installed?): ", cmd));
+                    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+                }
+                std::sort(times.begin(), times.end());
+                ImageErrorStats e = compareImages(readExr(out), reference);
+                BenchRow row{method, budget, times[times.size() / 2], e.rmse, e.relMse, 1};
+                std::fprintf(stderr, "bench: %-10s step %-8g %9.3f s  rmse %.5g  relmse %.5g\n", method.c_str(), budget,
+                             row.seconds, row.rmse, row.relMse);
+                result.rows.push_back(row);
+                continue;
+            }
             d.render.method = method;
             if (!o.budgetSeconds) d.render.spp = int(budget);
             auto scene = buildScene(d);

@@ -10,8 +10,9 @@
 namespace vdbmarch {
 
 struct BenchOptions {
-    std::vector<std::string> methods;
+    std::vector<std::string> methods;  // marchers, or "vdb_render" (OpenVDB's renderer)
     std::vector<double> budgets;  // spp, or seconds when budgetSeconds
+    std::vector<double> vdbRenderSteps{4, 2, 1, 0.5};  // the budgets of vdb_render: its step in voxels
     bool budgetSeconds = false;
     std::string outDir;
     std::string referencePath;  // given reference EXR; empty: render and cache one
