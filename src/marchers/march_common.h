@@ -76,8 +76,8 @@ int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tM
 
 // Walks a shadow ray from r.o over distance `dist` (Infinity: to the
 // environment), starting in `region`: calls segment(region, ray, tEnd) for
-// each piece between surfaces; interfaces are crossed (the region changes),
-// any other surface or a sphere light blocks. Returns false when blocked or
+// each piece between surfaces; interfaces and index-matched glass are crossed
+// (the region changes), any other surface or a sphere light blocks. Returns false when blocked or
 // when `segment` returned false.
 template <typename Segment>
 bool walkShadowRay(const Scene& scene, int region, Ray r, float dist, Segment&& segment) {
@@ -92,9 +92,12 @@ bool walkShadowRay(const Scene& scene, int region, Ray r, float dist, Segment&& 
         if (!segment(region, r, hit ? h.t : remaining)) return false;
         if (!hit) return true;
         const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
-        // Glass refracts and diffuse surfaces are opaque: a straight shadow
-        // ray cannot pass them.
-        if (s.material.type != MaterialDesc::Type::Interface) return false;
+        // Refracting glass bends the path and diffuse surfaces are opaque: a
+        // straight shadow ray cannot pass them. Index-matched glass (ior 1)
+        // neither reflects nor bends, so it is crossed like an interface.
+        bool straight = s.material.type == MaterialDesc::Type::Interface ||
+                        (s.material.type == MaterialDesc::Type::Dielectric && s.material.ior == 1.f);
+        if (!straight) return false;
         region = dot(r.d, h.n) < 0 ? s.interiorRegion : s.exteriorRegion;
         r.o = offsetRayOrigin(scene, h.p, h.n, r.d);
         if (std::isfinite(remaining)) remaining -= h.t;

@@ -48,7 +48,8 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
         bool deltaLight = false, glassWithMedium = false;
         for (const auto& l : desc.lights) deltaLight = deltaLight || l.type != LightDesc::Type::Sphere;
         for (const auto& s : desc.surfaces)
-            glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric && !s.interior.empty());
+            glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric &&
+                                                  s.material.ior != 1.f && !s.interior.empty());
         if (deltaLight && glassWithMedium)
             warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
                                 "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
