@@ -23,16 +23,6 @@ namespace vdbmarch {
 
 namespace {
 
-void writeText(const std::string& path, const std::string& text) {
-    AtomicFile f(path);
-    {
-        std::ofstream out(f.tempPath(), std::ios::binary);
-        out << text;
-        if (!out) throw IoError(str(path, ": cannot write"));
-    }
-    f.commit();
-}
-
 bool fileExists(const std::string& p) {
     struct stat st;
     return ::stat(p.c_str(), &st) == 0;
@@ -114,6 +104,14 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     ::mkdir(o.outDir.c_str(), 0755);
     checkWritable(o.outDir + "/bench.csv");
     BenchResult result;
+    // Loaded once: every render below only changes the render settings.
+    std::unique_ptr<Scene> scene = buildScene(baseScene);
+    auto renderWith = [&](const std::string& method, int spp, uint64_t seed, const RenderOptions& ro) {
+        scene->desc.render.method = method;
+        scene->desc.render.spp = spp;
+        scene->desc.render.seed = seed;
+        return renderImage(*scene, ro);
+    };
 
     // Reference: given, or the reference method at a high spp, cached by a
     // hash of the effective scene and spp. Rendered as two independent halves
@@ -134,13 +132,8 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
         } else {
             std::fprintf(stderr, "bench: rendering the reference (%d spp, method reference)...\n", o.referenceSpp);
             Image halves[2];
-            for (int i = 0; i < 2; ++i) {
-                SceneDesc d = baseScene;
-                d.render.method = "reference";
-                d.render.spp = std::max(1, o.referenceSpp / 2);
-                d.render.seed = 1000003u + uint64_t(i);
-                halves[i] = renderImage(*buildScene(d)).image;
-            }
+            for (int i = 0; i < 2; ++i)
+                halves[i] = renderWith("reference", std::max(1, o.referenceSpp / 2), 1000003u + uint64_t(i), {}).image;
             reference = Image(halves[0].width, halves[0].height);
             for (size_t i = 0; i < reference.rgba.size(); ++i)
                 reference.rgba[i] = 0.5f * (halves[0].rgba[i] + halves[1].rgba[i]);
@@ -153,12 +146,10 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
 
     for (const auto& method : o.methods) {
         for (double budget : method == "vdb_render" ? o.vdbRenderSteps : o.budgets) {
-            SceneDesc d = baseScene;
             if (method == "vdb_render") {
                 // Budget = step in voxels; time = the whole command (load + render + write).
-                auto scene = buildScene(d);
                 std::string out = o.outDir + str("/vdb_render_step", budget, ".exr");
-                std::string cmd = vdbRenderCommand(d, *scene, budget, out);
+                std::string cmd = vdbRenderCommand(baseScene, *scene, budget, out);
                 std::vector<double> times;
                 for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
                     auto t0 = std::chrono::steady_clock::now();
@@ -174,15 +165,13 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
                 result.rows.push_back(row);
                 continue;
             }
-            d.render.method = method;
-            if (!o.budgetSeconds) d.render.spp = int(budget);
-            auto scene = buildScene(d);
+            RenderOptions ro;
+            if (o.budgetSeconds) ro.timeBudget = budget;
+            const int spp = o.budgetSeconds ? baseScene.render.spp : int(budget);
             std::vector<double> times;
             RenderResult last;
             for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
-                RenderOptions ro;
-                if (o.budgetSeconds) ro.timeBudget = budget;
-                last = renderImage(*scene, ro);
+                last = renderWith(method, spp, baseScene.render.seed, ro);
                 times.push_back(last.seconds);
             }
             std::sort(times.begin(), times.end());
@@ -200,7 +189,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     for (const auto& r : result.rows)
         csv << r.method << "," << r.budget << "," << r.spp << "," << r.seconds << "," << r.rmse << "," << r.relMse << "\n";
     result.csvPath = o.outDir + "/bench.csv";
-    writeText(result.csvPath, csv.str());
+    writeTextFileAtomic(result.csvPath, csv.str());
 
     // Markdown: the measurements, then ratios between methods from power-law
     // fits error = c * time^b (log-log least squares per method), evaluated at
@@ -253,7 +242,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
         md << "\n";
     }
     result.tablePath = o.outDir + "/bench.md";
-    writeText(result.tablePath, md.str());
+    writeTextFileAtomic(result.tablePath, md.str());
 
     // Plot with gnuplot when it is installed (tools/plot_bench.gp).
     result.plotPath = o.outDir + "/bench.png";

@@ -38,6 +38,15 @@ bool endsWith(const std::string& s, const std::string& suffix) {
     return true;
 }
 
+// "--res WxH" as the override of camera.resolution (validated by the parser).
+std::string resolutionOverride(const std::string& res) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(res.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+        throw InputError(str("--res ", res, ": expected WIDTHxHEIGHT, e.g. 640x480"));
+    return str("camera.resolution=[", w, ",", h, "]");
+}
+
 struct RenderArgs {
     std::string input, output, png, method, res, stats, saveScene;
     // Options the user did not give keep the scene's values; given ones are
@@ -50,16 +59,6 @@ struct RenderArgs {
     bool quiet = false, noProgress = false;
     std::vector<std::string> sets;
 };
-
-void writeTextAtomic(const std::string& path, const std::string& text) {
-    AtomicFile f(path);
-    {
-        std::ofstream out(f.tempPath(), std::ios::binary);
-        out << text;
-        if (!out) throw IoError(str(path, ": cannot write"));
-    }
-    f.commit();
-}
 
 int runRender(const RenderArgs& a) {
     auto t0 = std::chrono::steady_clock::now();
@@ -92,17 +91,10 @@ int runRender(const RenderArgs& a) {
     if (a.threadsSet) overrides.push_back(str("render.threads=", a.threads));
     if (a.stepSet) overrides.push_back(str("render.step=", a.step));
     if (a.exposureSet) overrides.push_back(str("render.exposure=", a.exposure));
-    if (!a.res.empty()) {
-        int w = 0, h = 0;
-        char x = 0, extra = 0;
-        if (std::sscanf(a.res.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
-            throw InputError(str("--res ", a.res, ": expected WIDTHxHEIGHT, e.g. 640x480"));
-        overrides.push_back(str("camera.resolution=[", w, ",", h, "]"));
-    }
+    if (!a.res.empty()) overrides.push_back(resolutionOverride(a.res));
 
     SceneDesc desc = endsWith(a.input, ".vdb") ? loadAutoScene(a.input, overrides) : loadSceneFile(a.input, overrides);
     std::unique_ptr<Scene> scene = buildScene(desc);
-    makeMarcher(desc.render.method, *scene);  // validate before any work
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     RenderOptions options;
@@ -129,7 +121,7 @@ int runRender(const RenderArgs& a) {
         {"vdbmarch:scene", desc.json.dump()},
     };
     writeExr(a.output, r.image, attrs);
-    if (!a.saveScene.empty()) writeTextAtomic(a.saveScene, desc.json.dump(2) + "\n");
+    if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, desc.json.dump(2) + "\n");
     if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) {
@@ -146,7 +138,7 @@ int runRender(const RenderArgs& a) {
                          {"march_samples", c.marchSamples},     {"shadow_rays", c.shadowRays},
                          {"shadow_samples", c.shadowSamples},   {"non_finite_samples", c.nonFiniteSamples},
                          {"marched_length", c.marchedLength},   {"skipped_empty_length", c.skippedLength}};
-        writeTextAtomic(a.stats, s.dump(2) + "\n");
+        writeTextFileAtomic(a.stats, s.dump(2) + "\n");
     }
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (load %.3f s, total %.3f s) -> %s%s%s\n",
@@ -184,13 +176,7 @@ std::vector<std::string> splitList(const std::string& s) {
 
 int runBenchCommand(const BenchArgs& a) {
     std::vector<std::string> overrides = a.sets;
-    if (!a.res.empty()) {
-        int w = 0, h = 0;
-        char x = 0, extra = 0;
-        if (std::sscanf(a.res.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
-            throw InputError(str("--res ", a.res, ": expected WIDTHxHEIGHT, e.g. 320x240"));
-        overrides.push_back(str("camera.resolution=[", w, ",", h, "]"));
-    }
+    if (!a.res.empty()) overrides.push_back(resolutionOverride(a.res));
     SceneDesc desc = endsWith(a.scene, ".vdb") ? loadAutoScene(a.scene, overrides) : loadSceneFile(a.scene, overrides);
     BenchOptions o;
     o.methods = splitList(a.methods);

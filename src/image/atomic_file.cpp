@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <fstream>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -114,6 +115,16 @@ void checkWritable(const std::string& path) {
         throw IoError(str("cannot write '", path, "': directory '", dir, "': ", std::strerror(errno)));
     if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
         throw IoError(str("cannot write '", path, "': it is a directory"));
+}
+
+void writeTextFileAtomic(const std::string& path, const std::string& text) {
+    AtomicFile f(path);
+    {
+        std::ofstream out(f.tempPath(), std::ios::binary);
+        out << text;
+        if (!out) throw IoError(str("cannot write '", path, "'"));
+    }
+    f.commit();
 }
 
 }  // namespace vdbmarch

@@ -40,4 +40,7 @@ void removeTemporaryFilesOnInterrupt();
 // a long render does not fail at the very end.
 void checkWritable(const std::string& path);
 
+// Writes `text` to `path` through an AtomicFile.
+void writeTextFileAtomic(const std::string& path, const std::string& text);
+
 }  // namespace vdbmarch

@@ -67,16 +67,16 @@ private:
         if (m.maxDensity() > 0 && m.worldBounds().intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1, m.maxDensity()});
     }
 
-    // Combined majorant of the region's media along [0, tEnd) for `channel`;
-    // max over channels when channel < 0 (ratio tracking of all channels).
-    void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel, bool maxOverChannels,
+    // Combined majorant of the region's media along [0, tEnd) for the
+    // tracked `channel`.
+    void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,
                          std::vector<MajorantSegment>& out) const {
         out.clear();
         const auto& media = mScene.regions[size_t(region)].media;
         auto coefficient = [&](int mi) {
             const Medium& m = *mScene.media[size_t(mi)];
             Color k = m.sigma_a + m.sigma_s;
-            return maxOverChannels ? maxComponent(k) : trackedSigmaT(k, channel);
+            return trackedSigmaT(k, channel);
         };
         if (media.size() == 1) {
             float k = coefficient(media[0]);
@@ -130,24 +130,18 @@ private:
         if (media.empty()) return T;
         // Constant media: exact. Gridded media: ratio tracking with their
         // local majorants (max over channels, so weights stay in [0, 1]).
-        std::vector<int> gridded;
         for (int mi : media) {
-            float integral;
             const Medium& m = *mScene.media[size_t(mi)];
-            if (ctx.queries[size_t(mi)]->densityIntegral(r, 0.f, tEnd, integral)) {
-                Color k = m.sigma_a + m.sigma_s;
+            const Color k = m.sigma_a + m.sigma_s;
+            MediumQuery& q = *ctx.queries[size_t(mi)];
+            float integral;
+            if (q.densityIntegral(r, 0.f, tEnd, integral)) {
                 for (int c = 0; c < 3; ++c)
                     if (integral > 0 && k[c] > 0) T[c] *= std::exp(-k[c] * integral);
-            } else {
-                gridded.push_back(mi);
+                continue;
             }
-        }
-        for (int mi : gridded) {
-            const Medium& m = *mScene.media[size_t(mi)];
-            Color k = m.sigma_a + m.sigma_s;
             float kMax = maxComponent(k);
             if (!(kMax > 0)) continue;
-            MediumQuery& q = *ctx.queries[size_t(mi)];
             ctx.scratchSegments.clear();
             mediumMajorants(ctx, mi, r, tEnd, ctx.scratchSegments);
             for (const auto& seg : ctx.scratchSegments) {
@@ -295,7 +289,7 @@ private:
                     return track({s.t0, s.t1, s.maxDensity * k});
                 });
             } else if (!regionMedia.empty()) {
-                regionMajorants(ctx, region, ray, tEnd, channel, false, ctx.majorants);
+                regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);
                 for (const auto& seg : ctx.majorants)
                     if (!track(seg)) break;
             }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "marchers/marcher.h"
 #include "scene/json_locate.h"
 #include "scene/json_reader.h"
 #include "scene/scene_desc.h"
@@ -260,7 +261,7 @@ RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
                  "pixel_jitter", "exposure", "majorant"});
     RenderSettings s;
-    s.method = r.choice("method", s.method, {"uniform", "reference"});
+    s.method = r.choice("method", s.method, marcherNames());  // the factory table is the one list
     s.spp = r.integer("spp", s.spp, 1, 1 << 24);
     if (r.has("step")) s.step = float(r.positive("step", 1));
     if (r.has("shadow_step")) s.shadowStep = float(r.positive("shadow_step", 1));

@@ -257,7 +257,6 @@ private:
     void walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit);
 
     const VdbMedium& mMedium;
-    openvdb::FloatGrid::ConstAccessor mDensity;
     std::unique_ptr<openvdb::FloatGrid::ConstAccessor> mEmission;
     openvdb::tree::ValueAccessor<const BoolTree> mTopology;
     openvdb::tree::ValueAccessor<const openvdb::Int32Tree> mBlockIndex;
@@ -351,7 +350,7 @@ private:
 };
 
 VdbQuery::VdbQuery(const VdbMedium& m)
-    : mMedium(m), mDensity(m.mDensity->getConstAccessor()), mTopology(*m.mTopology), mBlockIndex(m.mBlocks.index) {
+    : mMedium(m), mTopology(*m.mTopology), mBlockIndex(m.mBlocks.index) {
     if (m.mEmissionGrid) mEmission = std::make_unique<openvdb::FloatGrid::ConstAccessor>(m.mEmissionGrid->getConstAccessor());
 }
 

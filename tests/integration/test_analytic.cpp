@@ -54,16 +54,7 @@ TEST(AnalyticMarcher, VdbBoxTransmittanceIsExactAtOneVoxelStep) {
 // L = scale * color * (1 - exp(-sigma_a * thickness)) exactly.
 TEST(AnalyticMarcher, EmissionOfAbsorbingBoxIsExact) {
     std::string vdb = tempDir() + "/emissive.vdb";
-    openvdb::initialize();
-    auto density = openvdb::FloatGrid::create(0.f);
-    density->setName("density");
-    density->setTransform(openvdb::math::Transform::createLinearTransform(0.05));
-    density->denseFill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(19)), 1.f, true);
-    auto temperature = openvdb::FloatGrid::create(0.f);
-    temperature->setName("temperature");
-    temperature->setTransform(openvdb::math::Transform::createLinearTransform(0.05));
-    temperature->denseFill(openvdb::CoordBBox(openvdb::Coord(-4), openvdb::Coord(24)), 1.f, true);
-    openvdb::io::File(vdb).write({density, temperature});
+    writeEmissiveBox(vdb);
     auto scene = sceneFromJson("{" + orthoCamera(0.5f, 8) + R"(,
         "media": [{"type": "vdb", "file": ")" + vdb + R"(", "sigma_a": [1.5, 1.5, 1.5], "sigma_s": 0,
                    "emission": {"grid": "temperature", "scale": 2, "color": [1, 0.5, 0.25]}}],
@@ -142,10 +133,7 @@ TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
     std::string small = tempDir() + "/blob.vdb", large = tempDir() + "/blob_far.vdb";
     writeBoxGrid(small, openvdb::Coord(0), openvdb::Coord(9), 0.5f, 0.05);
     {
-        auto grid = openvdb::FloatGrid::create(0.f);
-        grid->setName("density");
-        grid->setTransform(openvdb::math::Transform::createLinearTransform(0.05));
-        grid->denseFill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(9)), 0.5f, true);
+        auto grid = makeBoxGrid(openvdb::Coord(0), openvdb::Coord(9), 0.5f, 0.05);
         grid->tree().setValue(openvdb::Coord(-500, -500, -500), 0.5f);
         grid->tree().setValue(openvdb::Coord(500, 500, 500), 0.5f);
         openvdb::io::File(large).write({grid});
@@ -323,14 +311,7 @@ class VdbSingleScattering : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(VdbSingleScattering, MatchesClosedFormAlongTheAxis) {
     std::string vdb = tempDir() + "/ss_box.vdb";
-    openvdb::initialize();
-    {
-        auto grid = openvdb::FloatGrid::create(0.f);
-        grid->setName("density");
-        grid->setTransform(openvdb::math::Transform::createLinearTransform(0.05));
-        grid->denseFill(openvdb::CoordBBox(openvdb::Coord(0, 0, 0), openvdb::Coord(39, 39, 19)), 0.5f, true);
-        openvdb::io::File(vdb).write({grid});
-    }
+    writeBoxGrid(vdb, openvdb::Coord(0, 0, 0), openvdb::Coord(39, 39, 19), 0.5f, 0.05);
     const double sigmaS = 3, sigmaA = 1, g = 0.5, E = 2, Nh = 20 * 0.05 * 0.5;  // density 0.5
     const bool reference = GetParam() == "reference";
     auto scene = sceneFromJson(str(R"({"camera": {"type": "orthographic", "position": [0.975, 0.975, 3],
@@ -360,16 +341,7 @@ namespace {
 // collisions) against the closed form of an absorbing, emitting VDB box.
 TEST(Reference, EmissionOfAbsorbingBoxMatchesClosedForm) {
     std::string vdb = tempDir() + "/emissive_ref.vdb";
-    openvdb::initialize();
-    auto density = openvdb::FloatGrid::create(0.f);
-    density->setName("density");
-    density->setTransform(openvdb::math::Transform::createLinearTransform(0.05));
-    density->denseFill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(19)), 1.f, true);
-    auto temperature = openvdb::FloatGrid::create(0.f);
-    temperature->setName("temperature");
-    temperature->setTransform(openvdb::math::Transform::createLinearTransform(0.05));
-    temperature->denseFill(openvdb::CoordBBox(openvdb::Coord(-4), openvdb::Coord(24)), 1.f, true);
-    openvdb::io::File(vdb).write({density, temperature});
+    writeEmissiveBox(vdb);
     auto scene = sceneFromJson(R"({"camera": {"type": "orthographic", "position": [0.475, 0.475, 5],
         "look_at": [0.475, 0.475, 0], "width_world": 0.5, "resolution": [32, 32]},
         "media": [{"type": "vdb", "file": ")" + vdb + R"(", "sigma_a": [1.5, 1.5, 1.5], "sigma_s": 0,

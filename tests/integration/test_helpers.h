@@ -24,17 +24,29 @@ inline std::string tempDir() {
     return dir;
 }
 
-// Writes a float fog grid named `name` with value `v` in the index box
-// [lo, hi] (inclusive), voxel size h, to `path`.
-inline void writeBoxGrid(const std::string& path, const openvdb::Coord& lo, const openvdb::Coord& hi, float v,
-                         double h, const char* name = "density") {
+// A float fog grid named `name` with value `v` in the index box [lo, hi]
+// (inclusive), voxel size h.
+inline openvdb::FloatGrid::Ptr makeBoxGrid(const openvdb::Coord& lo, const openvdb::Coord& hi, float v, double h,
+                                           const char* name = "density") {
     openvdb::initialize();
     auto grid = openvdb::FloatGrid::create(0.f);
     grid->setName(name);
     grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
     grid->setGridClass(openvdb::GRID_FOG_VOLUME);
     grid->denseFill(openvdb::CoordBBox(lo, hi), v, true);
-    openvdb::io::File(path).write({grid});
+    return grid;
+}
+
+inline void writeBoxGrid(const std::string& path, const openvdb::Coord& lo, const openvdb::Coord& hi, float v,
+                         double h, const char* name = "density") {
+    openvdb::io::File(path).write({makeBoxGrid(lo, hi, v, h, name)});
+}
+
+// A 20^3-voxel density box of 1 (voxel 0.05) inside a larger `temperature`
+// box of 1, so L_e is constant wherever the density is non-zero.
+inline void writeEmissiveBox(const std::string& path) {
+    openvdb::io::File(path).write({makeBoxGrid(openvdb::Coord(0), openvdb::Coord(19), 1.f, 0.05),
+                                   makeBoxGrid(openvdb::Coord(-4), openvdb::Coord(24), 1.f, 0.05, "temperature")});
 }
 
 inline std::unique_ptr<Scene> sceneFromJson(const std::string& json) {
