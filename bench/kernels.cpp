@@ -5,6 +5,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include "cache/sh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "volume/medium.h"
@@ -101,6 +102,25 @@ void BM_HenyeyGreensteinSample(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_HenyeyGreensteinSample);
+
+// Real SH basis per direction (once per camera ray, once per photon per
+// cache cell): order 3 is the expanded polynomial path, order 8 the recurrence.
+void BM_EvalSh(benchmark::State& state) {
+    const int order = int(state.range(0));
+    Rng rng(5);
+    std::vector<Vec3> dirs;
+    for (int i = 0; i < 4096; ++i) dirs.push_back(sampleUniformSphere(rng.uniform(), rng.uniform()));
+    float Y[shCount(MaxShOrder)];
+    size_t i = 0;
+    for (auto _ : state) {
+        evalSh(order, dirs[i], Y);
+        benchmark::DoNotOptimize(Y);
+        benchmark::ClobberMemory();
+        i = (i + 1) & 4095;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_EvalSh)->Arg(3)->Arg(8);
 
 }  // namespace
 

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include <CLI/CLI.hpp>
+#include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -21,6 +22,8 @@
 #include "image/metrics.h"
 #include "image/png_io.h"
 #include "bench.h"
+#include "cache/bake.h"
+#include "cache/cache_inspect.h"
 #include "marchers/marcher.h"
 #include "render.h"
 #include "scene/auto_scene.h"
@@ -213,6 +216,113 @@ int runBenchCommand(const BenchArgs& a) {
     return 0;
 }
 
+struct BakeArgs {
+    std::string input, output, stats;
+    long long photons = 0;
+    int k = 0, shOrder = 0, threads = 0;
+    double quality = 0, minCell = 0;
+    long long seed = 0;
+    bool photonsSet = false, kSet = false, shOrderSet = false, qualitySet = false, minCellSet = false,
+         seedSet = false, threadsSet = false, adaptive = false, uniform = false, quiet = false;
+    std::vector<std::string> sets;
+};
+
+int runBake(const BakeArgs& a) {
+    if (!endsWith(a.output, ".vdb")) throw InputError(str("-o ", a.output, ": the cache must be a .vdb file"));
+    if (!a.stats.empty() && !endsWith(a.stats, ".json"))
+        throw InputError(str("--stats ", a.stats, ": the statistics file must be a .json file"));
+    if (a.adaptive && a.uniform) throw InputError("--adaptive and --uniform both given");
+    checkWritable(a.output);
+    if (!a.stats.empty()) checkWritable(a.stats);
+    // Options are overrides of the scene's "photons" and "cache" keys, so
+    // the scene parser validates them like any other key.
+    std::vector<std::string> overrides = a.sets;
+    if (a.photonsSet) overrides.push_back(str("photons.count=", a.photons));
+    if (a.kSet) overrides.push_back(str("photons.k=", a.k));
+    if (a.shOrderSet) overrides.push_back(str("cache.sh_order=", a.shOrder));
+    if (a.qualitySet) overrides.push_back(str("cache.quality=", a.quality));
+    if (a.minCellSet) overrides.push_back(str("cache.min_cell=", a.minCell));
+    if (a.adaptive) overrides.push_back("cache.adaptive=true");
+    if (a.uniform) overrides.push_back("cache.adaptive=false");
+    if (a.seedSet) overrides.push_back(str("render.seed=", a.seed));
+    if (a.threadsSet) overrides.push_back(str("render.threads=", a.threads));
+    SceneDesc desc = endsWith(a.input, ".vdb") ? loadAutoScene(a.input, overrides) : loadSceneFile(a.input, overrides);
+    std::unique_ptr<Scene> scene = buildScene(desc);
+    int threads = desc.render.threads > 0 ? desc.render.threads : tbb::info::default_concurrency();
+    tbb::task_arena arena(threads);
+    BakeResult r;
+    arena.execute([&] { r = bakeRadianceCache(*scene, desc.photons, desc.cache); });
+    r.cache.save(a.output);
+    const RadianceCache& c = r.cache;
+    if (!a.stats.empty()) {
+        nlohmann::json s;
+        s["seconds"] = {{"trace", r.traceSeconds}, {"kd_tree", r.treeSeconds}, {"topology", r.topologySeconds},
+                        {"estimate", r.estimateSeconds}, {"total", r.totalSeconds}};
+        s["threads"] = threads;
+        s["photon_paths"] = r.paths;
+        s["photons"] = c.info.photons;
+        s["direct_photons"] = r.directPhotons;
+        s["cells"] = c.cells.size();
+        s["levels"] = c.levels;
+        s["sh_order"] = c.info.shOrder;
+        s["bytes"] = {{"photon_map", r.photonBytes}, {"cache", r.cacheBytes}};
+        writeTextFileAtomic(a.stats, s.dump(2) + "\n");
+    }
+    if (!a.quiet)
+        std::fprintf(stderr,
+                     "vdbmarch: %zu photon paths -> %llu photons (%zu direct) in %.3f s; kd-tree %.3f s; %zu cells "
+                     "(%d level(s), SH order %d) in %.3f s; total %.3f s -> %s\n",
+                     r.paths, static_cast<unsigned long long>(c.info.photons), r.directPhotons, r.traceSeconds,
+                     r.treeSeconds, c.cells.size(), c.levels, c.info.shOrder, r.topologySeconds + r.estimateSeconds,
+                     r.totalSeconds, a.output.c_str());
+    return 0;
+}
+
+struct InspectArgs {
+    std::string input, direction, slice, output;
+};
+
+Vec3 parseDirection(const std::string& text) {
+    float x, y, z;
+    char extra;
+    if (std::sscanf(text.c_str(), "%f,%f,%f%c", &x, &y, &z, &extra) != 3 || !std::isfinite(x) || !std::isfinite(y) ||
+        !std::isfinite(z) || x * x + y * y + z * z == 0)
+        throw InputError(str("--direction ", text, ": expected a non-zero vector x,y,z"));
+    return normalize(Vec3(x, y, z));
+}
+
+int runInspect(const InspectArgs& a) {
+    RadianceCache c = RadianceCache::load(a.input);
+    if (a.slice.empty() && a.direction.empty()) {
+        if (!a.output.empty()) throw InputError("-o needs --direction (a .vdb of L_i) or --slice (a .png)");
+        std::printf("%s", cacheSummary(c).c_str());
+        return 0;
+    }
+    if (a.output.empty()) throw InputError("--direction and --slice write a file: give -o");
+    Vec3 wo(0);
+    if (!a.direction.empty()) wo = parseDirection(a.direction);
+    if (!a.slice.empty()) {
+        if (!endsWith(a.output, ".png")) throw InputError(str("-o ", a.output, ": a slice is written as .png"));
+        char axisName = 0, extra;
+        float value;
+        if (std::sscanf(a.slice.c_str(), "%c=%f%c", &axisName, &value, &extra) != 2 ||
+            (axisName != 'x' && axisName != 'y' && axisName != 'z') || !std::isfinite(value))
+            throw InputError(str("--slice ", a.slice, ": expected x=VALUE, y=VALUE or z=VALUE (world units)"));
+        checkWritable(a.output);
+        float maxL = writeCacheSlice(c, axisName - 'x', value, wo, a.output);
+        std::printf("slice %s: L_i %s, log scale from %g to %g (4 decades), black = no cell -> %s\n", a.slice.c_str(),
+                    a.direction.empty() ? "averaged over directions" : ("towards " + a.direction).c_str(),
+                    double(maxL) * 1e-4, double(maxL), a.output.c_str());
+        return 0;
+    }
+    if (!endsWith(a.output, ".vdb")) throw InputError(str("-o ", a.output, ": L_i for a direction is written as .vdb"));
+    checkWritable(a.output);
+    c.saveDirectional(a.output, wo);
+    std::printf("wrote L_i towards %s as float grid(s) 'Li%s' -> %s\n", a.direction.c_str(),
+                c.levels > 1 ? "_level<n>" : "", a.output.c_str());
+    return 0;
+}
+
 int runInfo(const std::string& file) {
     for (const auto& g : listVdbGrids(file)) std::printf("grid %s\n", g.c_str());
     VdbGridSummary s = summarizeVdb(file, "");
@@ -279,6 +389,30 @@ int main(int argc, char** argv) {
     bench->add_option("--res", ba.res, "Resolution WIDTHxHEIGHT");
     bench->add_option("--set", ba.sets, "Override a scene key: key.path=value, repeatable");
 
+    BakeArgs ka;
+    CLI::App* bake = app.add_subcommand("bake", "Trace photons and bake the in-scattered radiance cache to a .vdb");
+    bake->add_option("input", ka.input, "Scene .json, or a .vdb (automatic scene)")->required();
+    bake->add_option("-o,--output", ka.output, "Output cache (.vdb; one float grid per SH coefficient and level)")->required();
+    bake->add_option("--photons", ka.photons, "Photon paths to trace (scene key photons.count)")->each(flagSet(ka.photonsSet));
+    bake->add_option("--k", ka.k, "Photons per estimate (photons.k)")->each(flagSet(ka.kSet));
+    bake->add_option("--quality", ka.quality, "Grid quality a of s = (aN/(k V))^(1/3) (cache.quality)")->each(flagSet(ka.qualitySet));
+    bake->add_option("--sh-order", ka.shOrder, "Spherical-harmonics order K, 0-8 (cache.sh_order)")->each(flagSet(ka.shOrderSet));
+    bake->add_flag("--adaptive", ka.adaptive, "Octree-like cache subdivided where photons are dense (cache.adaptive)");
+    bake->add_flag("--uniform", ka.uniform, "Uniform cache even if the scene asks for an adaptive one");
+    bake->add_option("--min-cell", ka.minCell, "Smallest adaptive cell in world units (cache.min_cell)")->each(flagSet(ka.minCellSet));
+    bake->add_option("--seed", ka.seed, "Random seed")->each(flagSet(ka.seedSet));
+    bake->add_option("--threads", ka.threads, "Worker threads (0 = all cores)")->each(flagSet(ka.threadsSet));
+    bake->add_option("--set", ka.sets, "Override a scene key: key.path=value, repeatable");
+    bake->add_option("--stats", ka.stats, "Write timings, counts and memory as JSON");
+    bake->add_flag("-q,--quiet", ka.quiet, "No summary line");
+
+    InspectArgs ia;
+    CLI::App* inspect = app.add_subcommand("inspect", "Summarise a baked cache, or write L_i for a direction or a slice");
+    inspect->add_option("cache", ia.input, "Cache .vdb written by vdbmarch bake")->required();
+    inspect->add_option("--direction", ia.direction, "x,y,z: direction the light leaves in (towards the viewer)");
+    inspect->add_option("--slice", ia.slice, "x=V, y=V or z=V: a false-colour PNG slice at that world coordinate");
+    inspect->add_option("-o,--output", ia.output, "Output: .vdb with --direction alone, .png with --slice");
+
     std::string infoFile;
     CLI::App* info = app.add_subcommand("info", "List the grids of a .vdb file and summarise its density grid");
     info->add_option("file", infoFile, "VDB file")->required();
@@ -294,6 +428,8 @@ int main(int argc, char** argv) {
         if (*render) return runRender(ra);
         if (*compare) return runCompare(ca, cb, cdiff);
         if (*info) return runInfo(infoFile);
+        if (*bake) return runBake(ka);
+        if (*inspect) return runInspect(ia);
         if (*bench) return runBenchCommand(ba);
     } catch (const InputError& e) {
         std::fprintf(stderr, "vdbmarch: error: %s\n", e.what());

@@ -29,21 +29,21 @@ bool finiteRgb(const Image& img, size_t i) {
     return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
+}  // namespace
+
 // matplotlib's viridis sampled at 10 even steps (as R viridisLite::viridis(10)).
 constexpr uint8_t Viridis[10][3] = {
     {0x44, 0x01, 0x54}, {0x48, 0x28, 0x78}, {0x3E, 0x4A, 0x89}, {0x31, 0x68, 0x8E}, {0x26, 0x82, 0x8E},
     {0x1F, 0x9E, 0x89}, {0x35, 0xB7, 0x79}, {0x6D, 0xCD, 0x59}, {0xB4, 0xDE, 0x2C}, {0xFD, 0xE7, 0x25},
 };
 
-void viridis(double t, uint8_t out[3]) {
+void viridisColor(double t, uint8_t out[3]) {
     t = clamp(t, 0.0, 1.0) * 9.0;
     int i = std::min(int(t), 8);
     double f = t - i;
     for (int c = 0; c < 3; ++c)
         out[c] = uint8_t(std::lround(Viridis[i][c] + f * (Viridis[i + 1][c] - Viridis[i][c])));
 }
-
-}  // namespace
 
 ImageErrorStats compareImages(const Image& test, const Image& reference) {
     checkSameSize(test, reference);
@@ -106,7 +106,7 @@ void writeFalseColorDiff(const std::string& path, const Image& test, const Image
         if (err[i] < 0) {
             p[0] = 255; p[1] = 0; p[2] = 255;
         } else {
-            viridis(scale > 0 ? err[i] / scale : 0.0, p);
+            viridisColor(scale > 0 ? err[i] / scale : 0.0, p);
         }
     }
     writePngRgb8(path, test.width, test.height, rgb);

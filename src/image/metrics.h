@@ -4,6 +4,7 @@
 #include "image/image.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 namespace vdbmarch {
@@ -28,5 +29,8 @@ ImageErrorStats compareImages(const Image& test, const Image& reference);
 // the viridis ramp: dark purple = no error, yellow = at or above the 99th
 // percentile. Pixels non-finite in either image are magenta.
 void writeFalseColorDiff(const std::string& path, const Image& test, const Image& reference);
+
+// matplotlib's viridis colour map at t in [0, 1] (clamped), as 8-bit sRGB.
+void viridisColor(double t, uint8_t out[3]);
 
 }  // namespace vdbmarch

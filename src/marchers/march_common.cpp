@@ -205,4 +205,85 @@ Color directDiffuse(ThreadContext& ctx, int region, const Vec3& p, const Vec3& n
     return Lo;
 }
 
+
+void mediumMajorants(ThreadContext& ctx, int mi, const Ray& r, float tEnd, std::vector<MajorantSegment>& out) {
+    const Medium& m = *ctx.scene.media[size_t(mi)];
+    if (!ctx.scene.desc.render.globalMajorant || m.minVoxelSize() == 0) {
+        ctx.queries[size_t(mi)]->majorantSegments(r, 0.f, tEnd, out);
+        return;
+    }
+    float t0 = 0, t1 = tEnd;
+    if (m.maxDensity() > 0 && m.worldBounds().intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1, m.maxDensity()});
+}
+
+void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,
+                     std::vector<MajorantSegment>& out) {
+    out.clear();
+    const auto& media = ctx.scene.regions[size_t(region)].media;
+    auto coefficient = [&](int mi) {
+        const Medium& m = *ctx.scene.media[size_t(mi)];
+        return trackedSigmaT(m.sigma_a + m.sigma_s, channel);
+    };
+    if (media.size() == 1) {
+        float k = coefficient(media[0]);
+        mediumMajorants(ctx, media[0], r, tEnd, out);
+        for (auto& s : out) s.maxDensity *= k;
+        return;
+    }
+    // Several media: sum their piecewise-constant majorants.
+    std::vector<MajorantSegment> all;
+    std::vector<float> cuts;
+    std::vector<std::pair<size_t, size_t>> ranges;
+    for (int mi : media) {
+        size_t first = all.size();
+        mediumMajorants(ctx, mi, r, tEnd, all);
+        float k = coefficient(mi);
+        for (size_t i = first; i < all.size(); ++i) {
+            all[i].maxDensity *= k;
+            cuts.push_back(all[i].t0);
+            cuts.push_back(all[i].t1);
+        }
+        ranges.push_back({first, all.size()});
+    }
+    std::sort(cuts.begin(), cuts.end());
+    cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+    for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+        float a = cuts[i], b = cuts[i + 1], mid = 0.5f * (a + b), sum = 0;
+        if (!std::isfinite(mid)) mid = a + 1;
+        for (const auto& rg : ranges)
+            for (size_t j = rg.first; j < rg.second; ++j)
+                if (all[j].t0 <= mid && mid < all[j].t1) sum += all[j].maxDensity;
+        if (sum > 0) out.push_back({a, b, sum});
+    }
+}
+
+Vec3 sampleDielectric(const Vec3& d, const Vec3& outward, float ior, float u, bool& refracted) {
+    bool entering = dot(d, outward) < 0;
+    float eta = entering ? ior : 1 / ior;
+    Vec3 n = entering ? outward : -outward;
+    float cosI = -dot(d, n), cosT;
+    float F = fresnelDielectric(cosI, eta, &cosT);
+    refracted = !(u < F);
+    return normalize(refracted ? d / eta + n * (cosI / eta - cosT) : d + n * (2 * cosI));
+}
+
+Vec3 samplePhaseMixture(const MediumPoint& mp, const Vec3& d, Rng& rng, Color& weight, float& pdf) {
+    float total = 0;
+    for (int i = 0; i < mp.count; ++i) total += average(mp.sigmaS[i]);
+    float pick = rng.uniform() * total;
+    int k = 0;
+    while (k + 1 < mp.count && pick >= average(mp.sigmaS[k])) pick -= average(mp.sigmaS[k++]);
+    float cosT = sampleHgCosTheta(rng.uniform(), mp.g[k]);
+    Vec3 wi = directionAround(d, cosT, rng.uniform());
+    float c = dot(wi, d);
+    if (mp.count == 1) {
+        pdf = hgPhase(c, mp.g[0]);
+        return wi;
+    }
+    pdf = 0;
+    for (int i = 0; i < mp.count; ++i) pdf += average(mp.sigmaS[i]) / total * hgPhase(c, mp.g[i]);
+    weight *= phaseMixture(mp, c) / pdf;
+    return wi;
+}
+
 }  // namespace vdbmarch

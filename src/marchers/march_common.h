@@ -49,6 +49,29 @@ void regionIntervals(ThreadContext& ctx, int region, const Ray& r, float tMin, f
 // direction. Normalised so that huge coefficients cannot overflow.
 Color phaseMixture(const MediumPoint& mp, float cosTheta);
 
+// Extinction used for tracking: channel c, or (grey media, channel < 0) channel 0.
+inline float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[channel < 0 ? 0 : channel]; }
+
+// One medium's majorant segments along [0, tEnd): local (per VDB block) by
+// default; with render.global_majorant, the grid's maximum over its bounding
+// box (the classic baseline the local majorants are benchmarked against).
+void mediumMajorants(ThreadContext& ctx, int medium, const Ray& r, float tEnd, std::vector<MajorantSegment>& out);
+
+// Combined extinction majorant of the region's media along [0, tEnd) for the
+// tracked `channel` (delta tracking of paths and photons).
+void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,
+                     std::vector<MajorantSegment>& out);
+
+// Smooth dielectric with outward normal n: reflects with the Fresnel
+// probability, else refracts (the weights cancel). Returns the new unit
+// direction; `refracted` says whether it crossed to the other side.
+Vec3 sampleDielectric(const Vec3& d, const Vec3& n, float ior, float u, bool& refracted);
+
+// Samples the phase mixture at a scattering point (a medium by sigma_s, then
+// its HG lobe) around the travel direction d. Multiplies `weight` by f / pdf
+// per channel (1 for a single medium) and sets the direction's pdf.
+Vec3 samplePhaseMixture(const MediumPoint& mp, const Vec3& d, Rng& rng, Color& weight, float& pdf);
+
 // Transmittance from p along direction wi over distance `dist` (Infinity for
 // the environment/directional lights), starting in `region`. Interfaces are
 // crossed (the region changes), every other surface and sphere lights block.

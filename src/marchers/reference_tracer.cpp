@@ -51,66 +51,6 @@ public:
     }
 
 private:
-    // Extinction used for tracking: channel c, or (grey media) channel 0.
-    static float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[channel < 0 ? 0 : channel]; }
-
-    // One medium's majorant segments: local (per VDB block) by default; with
-    // render.majorant = "global", the grid's maximum over its whole bounding
-    // box, the classic baseline the local majorants are benchmarked against.
-    void mediumMajorants(ThreadContext& ctx, int mi, const Ray& r, float tEnd, std::vector<MajorantSegment>& out) const {
-        const Medium& m = *mScene.media[size_t(mi)];
-        if (!mScene.desc.render.globalMajorant || m.minVoxelSize() == 0) {
-            ctx.queries[size_t(mi)]->majorantSegments(r, 0.f, tEnd, out);
-            return;
-        }
-        float t0 = 0, t1 = tEnd;
-        if (m.maxDensity() > 0 && m.worldBounds().intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1, m.maxDensity()});
-    }
-
-    // Combined majorant of the region's media along [0, tEnd) for the
-    // tracked `channel`.
-    void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,
-                         std::vector<MajorantSegment>& out) const {
-        out.clear();
-        const auto& media = mScene.regions[size_t(region)].media;
-        auto coefficient = [&](int mi) {
-            const Medium& m = *mScene.media[size_t(mi)];
-            Color k = m.sigma_a + m.sigma_s;
-            return trackedSigmaT(k, channel);
-        };
-        if (media.size() == 1) {
-            float k = coefficient(media[0]);
-            mediumMajorants(ctx, media[0], r, tEnd, out);
-            for (auto& s : out) s.maxDensity *= k;
-            return;
-        }
-        // Several media: sum their piecewise-constant majorants.
-        std::vector<MajorantSegment> all;
-        std::vector<float> cuts;
-        std::vector<std::pair<size_t, size_t>> ranges;
-        for (int mi : media) {
-            size_t first = all.size();
-            mediumMajorants(ctx, mi, r, tEnd, all);
-            float k = coefficient(mi);
-            for (size_t i = first; i < all.size(); ++i) {
-                all[i].maxDensity *= k;
-                cuts.push_back(all[i].t0);
-                cuts.push_back(all[i].t1);
-            }
-            ranges.push_back({first, all.size()});
-        }
-        std::sort(cuts.begin(), cuts.end());
-        cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-        for (size_t i = 0; i + 1 < cuts.size(); ++i) {
-            float a = cuts[i], b = cuts[i + 1], mid = 0.5f * (a + b), sum = 0;
-            if (!std::isfinite(mid)) mid = a + 1;
-            for (const auto& rg : ranges)
-                for (size_t j = rg.first; j < rg.second; ++j)
-                    if (all[j].t0 <= mid && mid < all[j].t1) sum += all[j].maxDensity;
-            if (sum > 0) out.push_back({a, b, sum});
-        }
-    }
-
     // Ratio-tracking transmittance along a shadow ray through the region's
     // media over [0, dist); constant media exactly. Crosses interfaces,
     // stops at any other surface or a sphere light.
@@ -260,17 +200,8 @@ private:
                         return false;
                     }
                     L += beta * nextEvent(ctx, region, x, ray.d, &mp, nullptr, Color(0), rng);
-                    // Sample the phase mixture: pick a medium by sigma_s, then its lobe.
-                    float total = 0;
-                    for (int i = 0; i < mp.count; ++i) total += average(mp.sigmaS[i]);
-                    float pick = rng.uniform() * total;
-                    int k = 0;
-                    while (k + 1 < mp.count && pick >= average(mp.sigmaS[k])) pick -= average(mp.sigmaS[k++]);
-                    float cosT = sampleHgCosTheta(rng.uniform(), mp.g[k]);
-                    Vec3 wi = directionAround(ray.d, cosT, rng.uniform());
-                    float c = dot(wi, ray.d);
-                    float pdf = hgMix(mp, c);
-                    beta *= phaseMixture(mp, c) / pdf;  // f / pdf per channel (1 for one medium)
+                    float pdf;
+                    Vec3 wi = samplePhaseMixture(mp, ray.d, rng, beta, pdf);
                     lastPdf = pdf;
                     specular = false;
                     lastPoint = x;
@@ -342,18 +273,9 @@ private:
                 continue;
             }
             // Dielectric: Fresnel choice; the weights cancel.
-            float eta = entering ? s.material.ior : 1 / s.material.ior;
-            Vec3 n = entering ? h.n : -h.n;
-            float cosI = -dot(ray.d, n), cosT;
-            float F = fresnelDielectric(cosI, eta, &cosT);
-            Vec3 d;
-            if (rng.uniform() < F) {
-                d = ray.d + n * (2 * cosI);
-            } else {
-                d = ray.d / eta + n * (cosI / eta - cosT);
-                region = entering ? s.interiorRegion : s.exteriorRegion;
-            }
-            d = normalize(d);
+            bool refracted;
+            Vec3 d = sampleDielectric(ray.d, h.n, s.material.ior, rng.uniform(), refracted);
+            if (refracted) region = entering ? s.interiorRegion : s.exteriorRegion;
             specular = true;
             ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
         }

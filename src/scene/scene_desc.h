@@ -75,6 +75,20 @@ struct RenderSettings {
     bool globalMajorant = false;  // reference: one majorant per grid (benchmarks only)
 };
 
+// The volume photon map (scene key "photons").
+struct PhotonSettings {
+    int64_t count = 100000;  // photon paths traced
+    int k = 50;              // photons per radiance estimate (eq. 4)
+};
+
+// The radiance cache (scene key "cache"; sections 3.1-3.4).
+struct CacheSettings {
+    int shOrder = 3;        // K: (K + 1)^2 coefficients; 0 is the paper's scalar cache
+    float quality = 1;      // the paper's a
+    bool adaptive = false;  // octree-like subdivision where photons are dense
+    float minCell = 0;      // smallest adaptive cell, world units (0: automatic)
+};
+
 struct SceneDesc {
     std::string file;     // scene file (or .vdb) the description came from
     std::string baseDir;  // relative paths resolve against this
@@ -84,6 +98,8 @@ struct SceneDesc {
     std::vector<SurfaceDesc> surfaces;
     Color background{0, 0, 0};
     RenderSettings render;
+    PhotonSettings photons;
+    CacheSettings cache;
     nlohmann::json json;  // the effective document, recorded in outputs
 };
 

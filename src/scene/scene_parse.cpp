@@ -280,6 +280,29 @@ RenderSettings parseRender(const JsonReader& r) {
     return s;
 }
 
+PhotonSettings parsePhotons(const JsonReader& r) {
+    r.allowOnly({"count", "k"});
+    PhotonSettings s;
+    if (r.has("count")) {
+        const Json& v = r.raw("count");
+        if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > (1LL << 32))
+            r.fail("count", str("must be an integer in [0, 2^32], got ", jsonExcerpt(v)));
+        s.count = v.get<int64_t>();
+    }
+    s.k = r.integer("k", s.k, 1, 1024);
+    return s;
+}
+
+CacheSettings parseCache(const JsonReader& r) {
+    r.allowOnly({"sh_order", "quality", "adaptive", "min_cell"});
+    CacheSettings s;
+    s.shOrder = r.integer("sh_order", s.shOrder, 0, 8);
+    s.quality = float(r.positive("quality", s.quality));
+    s.adaptive = r.boolean("adaptive", s.adaptive);
+    if (r.has("min_cell")) s.minCell = float(r.positive("min_cell", 1));
+    return s;
+}
+
 }  // namespace
 
 std::string resolvePath(const std::string& baseDir, const std::string& path) {
@@ -294,7 +317,7 @@ SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
     scene.baseDir = slash == std::string::npos ? "." : file.substr(0, slash == 0 ? 1 : slash);
     scene.json = doc;
     JsonReader root(doc, file, "");
-    root.allowOnly({"camera", "lights", "media", "surfaces", "background", "render"});
+    root.allowOnly({"camera", "lights", "media", "surfaces", "background", "render", "photons", "cache"});
     if (root.has("camera")) scene.camera = parseCamera(root.object("camera"));
     auto listOf = [&](const char* key) -> const Json& {
         const Json& v = root.raw(key);
@@ -341,6 +364,8 @@ SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
     }
     scene.background = root.nonNegativeColor("background", Vec3(0));
     if (root.has("render")) scene.render = parseRender(root.object("render"));
+    if (root.has("photons")) scene.photons = parsePhotons(root.object("photons"));
+    if (root.has("cache")) scene.cache = parseCache(root.object("cache"));
     return scene;
 }
 

@@ -167,4 +167,17 @@ bool SurfaceSet::intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit
     return true;
 }
 
+BBox SurfaceSet::bounds() const {
+    BBox b;
+    for (const Geometry& g : mGeometries) {
+        if (g.sphere) {
+            for (int i = 0; i < 8; ++i)
+                b.expand(g.toWorld.point(Vec3(i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 1.f : -1.f)));
+        } else {
+            for (const Vec3& p : g.mesh.positions) b.expand(p);
+        }
+    }
+    return b;
+}
+
 }  // namespace vdbmarch

@@ -37,6 +37,8 @@ public:
     bool empty() const { return mGeometries.empty(); }
     // Closest hit with t in (tMin, tMax).
     bool intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit) const;
+    // World bounds of every surface (empty box when there are none).
+    BBox bounds() const;
     // Number of triangles and spheres, for stats.
     size_t primitiveCount() const;
 

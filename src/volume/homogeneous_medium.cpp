@@ -55,6 +55,9 @@ public:
         return b;
     }
     float maxDensity() const override { return 1; }
+    void activeBoxes(std::vector<BBox>& out) const override {
+        if (mBounded) out.push_back(mBounds);
+    }
 
 private:
     bool mBounded;

@@ -51,6 +51,18 @@ public:
                                  const std::function<bool(const MajorantSegment&)>& visit) = 0;
 };
 
+// Picks points of an emissive medium for photon emission. The pdf (per unit
+// world volume) is positive wherever the trilinear emission can be, so the
+// emitted power estimate 4 pi sigma_a rho L_e / pdf is unbiased.
+class EmissionSampler {
+public:
+    virtual ~EmissionSampler() = default;
+    virtual void sample(const float u[4], Vec3& p, float& pdf) const = 0;
+    // Approximate integral of density x emission over the grid (world
+    // volume units), used to share photons between lights.
+    virtual float integralEstimate() const = 0;
+};
+
 class Medium {
 public:
     virtual ~Medium() = default;
@@ -61,6 +73,12 @@ public:
     virtual float minVoxelSize() const { return 0; }
     virtual float maxDensity() const = 0;
     virtual size_t activeVoxelCount() const { return 0; }
+    // World boxes that together cover every point with density > 0: one per
+    // non-empty 8^3 VDB block, the box of a bounded homogeneous medium, none
+    // for unbounded fog (which has an infinite worldBounds()).
+    virtual void activeBoxes(std::vector<BBox>& out) const = 0;
+    // Null when the medium does not emit.
+    virtual std::unique_ptr<EmissionSampler> makeEmissionSampler() const { return nullptr; }
     // True when the medium can never attenuate or emit (skip it entirely).
     bool isVacuum() const {
         return maxDensity() <= 0 || (isBlack(sigma_a) && isBlack(sigma_s));

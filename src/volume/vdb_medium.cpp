@@ -280,6 +280,7 @@ public:
         mScale = d.densityScale;
         Mat4 i2w = indexToWorldMatrix(*mDensity, d.transform, what);
         mW2I = Affine(i2w.inverse(what.c_str()));
+        mI2W = i2w;
         // World-space length of each index axis; the step default uses the smallest.
         mMinVoxel = Infinity;
         for (int c = 0; c < 3; ++c) {
@@ -324,7 +325,8 @@ public:
             const std::string ewhat = str(d.file, ": emission grid '", d.emissionGrid, "'");
             mEmissionGrid = readFloatGrid(d.file, d.emissionGrid);
             sanitize(*mEmissionGrid, ewhat);
-            mEmissionW2I = Affine(indexToWorldMatrix(*mEmissionGrid, d.transform, ewhat).inverse(ewhat.c_str()));
+            mEmissionI2W = indexToWorldMatrix(*mEmissionGrid, d.transform, ewhat);
+            mEmissionW2I = Affine(mEmissionI2W.inverse(ewhat.c_str()));
             mEmissionScale = d.emissionScale;
             hasEmission = d.emissionScale > 0 && !isBlack(d.emissionColor) && !isBlack(d.sigma_a);
             emissionColor = d.emissionColor;
@@ -336,9 +338,13 @@ public:
     float minVoxelSize() const override { return mMinVoxel; }
     float maxDensity() const override { return mMaxDensity; }
     size_t activeVoxelCount() const override { return mActiveVoxels; }
+    void activeBoxes(std::vector<BBox>& out) const override;
+    std::unique_ptr<EmissionSampler> makeEmissionSampler() const override;
 
 private:
     friend class VdbQuery;
+    friend class VdbEmissionSampler;
+    Mat4 mI2W = Mat4::identity(), mEmissionI2W = Mat4::identity();
     openvdb::FloatGrid::Ptr mDensity, mEmissionGrid;
     std::unique_ptr<BoolTree> mTopology;
     PaddedBlocks mBlocks;
@@ -348,6 +354,104 @@ private:
     float mScale = 1, mEmissionScale = 0, mMinVoxel = 0, mMaxDensity = 0;
     size_t mActiveVoxels = 0;
 };
+
+// World AABB of an index-space box [lo, hi] under an affine index-to-world map.
+BBox worldBoxOf(const Mat4& i2w, const openvdb::Vec3d& lo, const openvdb::Vec3d& hi) {
+    BBox b;
+    for (int i = 0; i < 8; ++i) {
+        double c[3] = {i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()};
+        Vec3 w;
+        for (int r = 0; r < 3; ++r)
+            w[r] = float(i2w.m[r][0] * c[0] + i2w.m[r][1] * c[1] + i2w.m[r][2] * c[2] + i2w.m[r][3]);
+        b.expand(w);
+    }
+    return b;
+}
+
+void VdbMedium::activeBoxes(std::vector<BBox>& out) const {
+    if (mMaxDensity <= 0) return;
+    for (auto it = mBlocks.index.cbeginValueOn(); it; ++it) {
+        int32_t id = *it;
+        if (id <= 0 || !(mBlocks.blockMax[size_t(id - 1)] > 0)) continue;
+        uint32_t tb = mBlocks.tightBox[size_t(id - 1)];
+        openvdb::Coord o = it.getCoord();
+        openvdb::Vec3d lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = o[a] + double((tb >> (4 * a)) & 15u);
+            hi[a] = o[a] + double((tb >> (12 + 4 * a)) & 15u);
+        }
+        if (hi.x() > lo.x() && hi.y() > lo.y() && hi.z() > lo.z()) out.push_back(worldBoxOf(mI2W, lo, hi));
+    }
+}
+
+// Voxels of the emission grid, dilated by one (the trilinear stencil), each
+// weighted by the largest emission value its interpolation can see; a point
+// is drawn uniformly inside the chosen voxel's [c, c+1)^3 index cell.
+class VdbEmissionSampler final : public EmissionSampler {
+public:
+    explicit VdbEmissionSampler(const VdbMedium& m) : mI2W(m.mEmissionI2W) {
+        const auto& grid = *m.mEmissionGrid;
+        BoolTree topology(grid.tree(), false, openvdb::TopologyCopy());
+        openvdb::tools::dilateActiveValues(topology, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                           openvdb::tools::EXPAND_TILES);
+        auto acc = grid.getConstAccessor();
+        auto dens = m.mDensity->getConstAccessor();
+        double det = std::fabs(mI2W.m[0][0] * (mI2W.m[1][1] * mI2W.m[2][2] - mI2W.m[1][2] * mI2W.m[2][1]) -
+                               mI2W.m[0][1] * (mI2W.m[1][0] * mI2W.m[2][2] - mI2W.m[1][2] * mI2W.m[2][0]) +
+                               mI2W.m[0][2] * (mI2W.m[1][0] * mI2W.m[2][1] - mI2W.m[1][1] * mI2W.m[2][0]));
+        mVoxelVolume = float(det);
+        double total = 0, estimate = 0;
+        for (auto it = topology.cbeginValueOn(); it; ++it) {
+            openvdb::Coord c = it.getCoord();
+            // The cell [c, c+1) interpolates the values at c + {0,1}^3.
+            float w = 0;
+            for (int i = 0; i < 8; ++i)
+                w = std::max(w, acc.getValue(c.offsetBy(i & 1, (i >> 1) & 1, (i >> 2) & 1)));
+            if (!(w > 0)) continue;
+            total += w;
+            mCoords.push_back(c);
+            mCdf.push_back(total);
+            // Density at the cell centre, for the power estimate only.
+            openvdb::Vec3d centre(c.x() + 0.5, c.y() + 0.5, c.z() + 0.5);
+            Vec3 wc;
+            for (int r = 0; r < 3; ++r)
+                wc[r] = float(mI2W.m[r][0] * centre[0] + mI2W.m[r][1] * centre[1] + mI2W.m[r][2] * centre[2] + mI2W.m[r][3]);
+            float rho = sampleTrilinear(dens, m.mW2I.point(wc)) * m.mScale;
+            estimate += double(rho) * sampleTrilinear(acc, centre);
+        }
+        for (double& v : mCdf) v /= total;
+        mIntegral = float(estimate * mVoxelVolume * m.mEmissionScale);
+        for (size_t i = 0; i < mCdf.size(); ++i) mWeights.push_back(float((i ? mCdf[i] - mCdf[i - 1] : mCdf[i])));
+    }
+
+    bool empty() const { return mCoords.empty(); }
+
+    void sample(const float u[4], Vec3& p, float& pdf) const override {
+        size_t i = size_t(std::lower_bound(mCdf.begin(), mCdf.end(), double(u[0])) - mCdf.begin());
+        i = std::min(i, mCdf.size() - 1);
+        const openvdb::Coord& c = mCoords[i];
+        double q[3] = {c.x() + double(u[1]), c.y() + double(u[2]), c.z() + double(u[3])};
+        for (int r = 0; r < 3; ++r)
+            p[r] = float(mI2W.m[r][0] * q[0] + mI2W.m[r][1] * q[1] + mI2W.m[r][2] * q[2] + mI2W.m[r][3]);
+        pdf = mWeights[i] / mVoxelVolume;
+    }
+
+    float integralEstimate() const override { return mIntegral; }
+
+private:
+    Mat4 mI2W;
+    std::vector<openvdb::Coord> mCoords;
+    std::vector<double> mCdf;
+    std::vector<float> mWeights;
+    float mVoxelVolume = 1, mIntegral = 0;
+};
+
+std::unique_ptr<EmissionSampler> VdbMedium::makeEmissionSampler() const {
+    if (!hasEmission || !mEmissionGrid || mMaxDensity <= 0) return nullptr;
+    auto s = std::make_unique<VdbEmissionSampler>(*this);
+    if (s->empty()) return nullptr;
+    return s;
+}
 
 VdbQuery::VdbQuery(const VdbMedium& m)
     : mMedium(m), mTopology(*m.mTopology), mBlockIndex(m.mBlocks.index) {

@@ -1,0 +1,65 @@
+// One stored photon, 32 bytes: position, travel direction (octahedral, 2 x 16
+// bits), and its fluence weight. Photons are stored at every real collision
+// in a medium (scattering or absorption) with the weight Phi / sigma_t(x_p):
+// collisions happen at rate sigma_t times the radiance, so dividing by the
+// extinction where the photon landed makes the sum over a volume an estimate
+// of the integral of the radiance (docs/method.md, "Photon map").
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/math.h"
+
+namespace vdbmarch {
+
+// Octahedral encoding of a unit vector in 32 bits (max error ~3e-5 rad).
+inline uint32_t encodeDirection(const Vec3& d) {
+    float l1 = std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z);
+    float u = d.x / l1, v = d.y / l1;
+    if (d.z < 0) {
+        float pu = (1 - std::fabs(v)) * (u >= 0 ? 1.f : -1.f);
+        float pv = (1 - std::fabs(u)) * (v >= 0 ? 1.f : -1.f);
+        u = pu;
+        v = pv;
+    }
+    auto q = [](float x) {
+        return uint32_t(std::lround(std::min(1.f, std::max(-1.f, x)) * 32767.f) + 32767);
+    };
+    return q(u) | (q(v) << 16);
+}
+
+inline Vec3 decodeDirection(uint32_t e) {
+    float u = float(int(e & 0xffffu) - 32767) / 32767.f;
+    float v = float(int(e >> 16) - 32767) / 32767.f;
+    Vec3 d(u, v, 1 - std::fabs(u) - std::fabs(v));
+    if (d.z < 0) {
+        float du = (1 - std::fabs(v)) * (u >= 0 ? 1.f : -1.f);
+        float dv = (1 - std::fabs(u)) * (v >= 0 ? 1.f : -1.f);
+        d.x = du;
+        d.y = dv;
+    }
+    return normalize(d);
+}
+
+struct Photon {
+    enum Flags : uint32_t { Direct = 1u };  // straight from a light: shadow rays compute this light
+    Vec3 position;
+    uint32_t direction;  // encodeDirection(travel direction)
+    Color weight;        // Phi / sigma_t at the collision (W m), per channel
+    uint32_t flags;      // bit 0: Direct; bits 16-31: the phase g there, as int16 / 32767
+
+    Vec3 travelDirection() const { return decodeDirection(direction); }
+    bool isDirect() const { return (flags & Direct) != 0; }
+    // Mean cosine of the phase function where the photon landed (the
+    // sigma_s-weighted mean over the media there), for eq. 27's w'_l = g^l.
+    float g() const { return float(int16_t(uint16_t(flags >> 16))) / 32767.f; }
+    static uint32_t packFlags(bool direct, float g) {
+        int q = int(std::lround(std::min(1.f, std::max(-1.f, g)) * 32767.f));
+        return (direct ? Direct : 0u) | (uint32_t(uint16_t(int16_t(q))) << 16);
+    }
+};
+static_assert(sizeof(Photon) == 32, "photons are stored compactly");
+
+}  // namespace vdbmarch

@@ -1,0 +1,63 @@
+// The volume photon map: photons sorted along a Morton curve (so that
+// neighbours are close in memory) and a nanoflann kd-tree over them for
+// k-nearest-neighbour queries, with the in-scattered radiance estimate of
+// eq. 4.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "photons/photon.h"
+
+namespace vdbmarch {
+
+class PhotonMap {
+public:
+    // Takes the photons; builds the tree. `paths` is the number of photon
+    // paths they came from (for records only: their weights already carry 1/N).
+    explicit PhotonMap(std::vector<Photon> photons);
+    ~PhotonMap();
+    PhotonMap(const PhotonMap&) = delete;
+    PhotonMap& operator=(const PhotonMap&) = delete;
+
+    size_t size() const { return mPhotons.size(); }
+    const std::vector<Photon>& photons() const { return mPhotons; }
+    const Photon& operator[](size_t i) const { return mPhotons[i]; }
+
+    // The (up to) k photons nearest to x, nearest first: indices into
+    // photons() and squared distances. Returns how many were found.
+    size_t nearest(const Vec3& x, size_t k, uint32_t* indices, float* dist2) const;
+
+    // Eq. 4: L_i(x, wo) = sum_p p(omega_p . wo) Phi_p / (sigma_t,p dV), over
+    // the k nearest photons, dV the sphere that holds them. The weights of
+    // stored photons are Phi_p / sigma_t(x_p); wo is the direction the light
+    // leaves in (towards the viewer), `phase(cos)` the phase function (a
+    // Color) with cos between a photon's travel direction and wo.
+    template <typename Phase>
+    Color estimateLi(const Vec3& x, const Vec3& wo, size_t k, Phase&& phase) const {
+        constexpr size_t MaxK = 1024;
+        uint32_t idx[MaxK];
+        float d2[MaxK];
+        size_t n = nearest(x, k < MaxK ? k : MaxK, idx, d2);
+        if (n == 0) return Color(0);
+        Color sum(0);
+        for (size_t i = 0; i < n; ++i) {
+            const Photon& p = mPhotons[idx[i]];
+            sum += p.weight * phase(dot(p.travelDirection(), wo));
+        }
+        float r2 = d2[n - 1];
+        if (!(r2 > 0)) return Color(0);
+        return sum / (4.f / 3.f * Pi * r2 * std::sqrt(r2));
+    }
+
+    // Bytes held by the photons and the tree.
+    size_t memoryBytes() const;
+
+private:
+    struct Tree;
+    std::vector<Photon> mPhotons;
+    std::unique_ptr<Tree> mTree;
+};
+
+}  // namespace vdbmarch

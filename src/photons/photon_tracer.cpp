@@ -1,0 +1,314 @@
+#include "photons/photon_tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "core/sampling.h"
+#include "marchers/march_common.h"
+
+namespace vdbmarch {
+
+namespace {
+
+// A light, the background or an emissive medium. sample() gives a photon
+// whose power is an unbiased estimate of the source's total power.
+struct PhotonSource {
+    PhotonEmitter emitter;                    // lights and the background
+    std::unique_ptr<EmissionSampler> volume;  // emissive media
+    int medium = -1;
+    Color power{0, 0, 0};  // allocation weight
+    size_t first = 0, count = 0;  // its range of path indices
+};
+
+bool scatters(const Medium& m) { return !m.isVacuum() && !isBlack(m.sigma_s); }
+
+// Paths are cut into fixed chunks so the photon order (and the per-path
+// random streams) do not depend on how TBB schedules them.
+constexpr size_t ChunkPaths = 2048;
+
+class PhotonTracer {
+public:
+    PhotonTracer(const Scene& scene, uint64_t seed) : mScene(scene), mSeed(seed) {
+        for (const auto& m : scene.media) {
+            Color k = m->sigma_a + m->sigma_s;
+            mChromatic = mChromatic || k.x != k.y || k.y != k.z;
+        }
+    }
+
+    // Traces path `index` of `source`, appending its photons.
+    void tracePath(ThreadContext& ctx, const PhotonSource& src, size_t index, std::vector<Photon>& out) const {
+        Rng rng(hashValues(mSeed, 0x70686f746f6e73ULL, index));
+        float u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
+        EmittedPhoton ep;
+        Color power;
+        if (src.volume) {
+            Vec3 p;
+            float pdf;
+            src.volume->sample(u, p, pdf);
+            if (!(pdf > 0)) return;
+            const Medium& m = *mScene.media[size_t(src.medium)];
+            float rho = ctx.queries[size_t(src.medium)]->density(p);
+            float e = ctx.queries[size_t(src.medium)]->emission(p);
+            if (!(rho > 0 && e > 0)) return;
+            // Isotropic emission: 4 pi sigma_a rho L_e per unit volume.
+            ep.power = m.sigma_a * m.emissionColor * (4 * Pi * rho * e / pdf);
+            ep.ray = Ray{p, sampleUniformSphere(rng.uniform(), rng.uniform())};
+        } else if (!src.emitter.sample(u, ep)) {
+            return;
+        }
+        power = ep.power / float(src.count);
+        if (!(maxComponent(power) > 0) || !std::isfinite(maxComponent(power))) return;
+        int channel = -1;
+        if (mChromatic) {  // one channel per path keeps delta tracking unbiased
+            channel = std::min(2, int(rng.uniform() * 3));
+            Color only(0);
+            only[channel] = power[channel] * 3;
+            power = only;
+            if (!(power[channel] > 0)) return;
+        }
+        follow(ctx, ep.ray, power, channel, rng, out);
+    }
+
+private:
+    void follow(ThreadContext& ctx, Ray ray, Color power, int channel, Rng& rng, std::vector<Photon>& out) const {
+        const Scene& scene = mScene;
+        const int maxDepth = scene.desc.render.maxDepth;
+        int region = regionAtRayStart(scene, ray);
+        int depth = 0, surfaceBounces = 0;
+        bool direct = true;
+        MediumPoint mp;
+        while (true) {
+            SurfaceHit h;
+            bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
+            float tLight = Infinity;
+            int light = intersectSphereLights(scene, ray, 1e-4f * scene.sceneScale, hit ? h.t : Infinity, tLight);
+            float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+
+            // Delta tracking to the next real collision; the photon is stored
+            // there, then scatters with probability albedo (Russian roulette).
+            bool scattered = false, ended = false;
+            auto track = [&](const MajorantSegment& seg) {
+                const float sigmaMaj = seg.maxDensity;
+                if (!(sigmaMaj > 0)) return true;
+                double t = seg.t0;
+                while (true) {
+                    t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
+                    if (t >= seg.t1) return true;
+                    Vec3 x = ray.at(t);
+                    evalMedia(ctx, region, x, mp);
+                    float sa = channel < 0 ? average(mp.sigma_a) : mp.sigma_a[channel];
+                    float ss = channel < 0 ? average(mp.sigma_s) : mp.sigma_s[channel];
+                    if (rng.uniform() * sigmaMaj >= sa + ss) continue;  // null collision
+                    float st = sa + ss;
+                    Photon ph;
+                    ph.position = x;
+                    ph.direction = encodeDirection(ray.d);
+                    ph.weight = power / st;  // grey extinction: sigma_t is the same in every channel
+                    float gMean = 0, ssSum = 0;
+                    for (int i = 0; i < mp.count; ++i) {
+                        gMean += average(mp.sigmaS[i]) * mp.g[i];
+                        ssSum += average(mp.sigmaS[i]);
+                    }
+                    ph.flags = Photon::packFlags(direct, ssSum > 0 ? gMean / ssSum : 0.f);
+                    out.push_back(ph);
+                    if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
+                        ended = true;
+                        return false;
+                    }
+                    if (channel < 0) power *= mp.sigma_s / ss;  // per-channel albedo over its mean
+                    float pdf;
+                    ray = Ray{x, samplePhaseMixture(mp, ray.d, rng, power, pdf)};
+                    direct = false;
+                    scattered = true;
+                    return false;
+                }
+            };
+            const auto& media = scene.regions[size_t(region)].media;
+            if (media.size() == 1) {
+                const Medium& m = *scene.media[size_t(media[0])];
+                const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
+                const Ray segmentRay = ray;
+                ctx.queries[size_t(media[0])]->forEachMajorant(segmentRay, 0.f, tEnd, [&](const MajorantSegment& s) {
+                    return track({s.t0, s.t1, s.maxDensity * k});
+                });
+            } else if (!media.empty()) {
+                regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);
+                for (const auto& seg : ctx.majorants)
+                    if (!track(seg)) break;
+            }
+            if (ended) return;
+            if (scattered) {
+                if (!std::isfinite(maxComponent(power))) return;
+                continue;
+            }
+            if (light >= 0 || !hit) return;  // absorbed by a light, or escaped
+            if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return;
+            const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+            bool entering = dot(ray.d, h.n) < 0;
+            if (s.material.type == MaterialDesc::Type::Interface) {
+                region = entering ? s.interiorRegion : s.exteriorRegion;
+                ray.o = offsetRayOrigin(scene, h.p, h.n, ray.d);
+                continue;
+            }
+            if (s.material.type == MaterialDesc::Type::Diffuse) {
+                if (++depth >= maxDepth) return;
+                float a = maxComponent(s.material.albedo);
+                if (!(rng.uniform() < a)) return;  // Russian roulette by albedo
+                power *= s.material.albedo / a;
+                Vec3 nf = entering ? h.n : -h.n;
+                float u1 = rng.uniform(), u2 = rng.uniform();
+                Vec3 wi = directionAround(nf, std::sqrt(1 - u1), u2);
+                ray = Ray{offsetRayOrigin(scene, h.p, h.n, wi), wi};
+                direct = false;
+                continue;
+            }
+            // Dielectric: reflection or refraction by Fresnel. Index-matched
+            // glass is crossed straight, as shadow rays cross it, so such
+            // photons stay direct.
+            bool refracted;
+            Vec3 d = sampleDielectric(ray.d, h.n, s.material.ior, rng.uniform(), refracted);
+            if (refracted) region = entering ? s.interiorRegion : s.exteriorRegion;
+            if (s.material.ior != 1.f) direct = false;
+            ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
+        }
+    }
+
+    const Scene& mScene;
+    uint64_t mSeed;
+    bool mChromatic = false;
+};
+
+}  // namespace
+
+bool sceneScatters(const Scene& scene) {
+    for (const auto& m : scene.media)
+        if (scatters(*m)) return true;
+    return false;
+}
+
+PhotonTarget photonTarget(const Scene& scene) {
+    PhotonTarget t;
+    BBox finite;
+    for (const auto& m : scene.media) {
+        if (m->isVacuum()) continue;
+        BBox b = m->worldBounds();
+        bool bounded = std::isfinite(b.lo.x) && std::isfinite(b.hi.x) && std::isfinite(b.lo.y) &&
+                       std::isfinite(b.hi.y) && std::isfinite(b.lo.z) && std::isfinite(b.hi.z);
+        if (!bounded) {
+            if (scatters(*m)) t.unbounded = true;
+            continue;
+        }
+        if (scatters(*m)) t.bounds.expand(b);
+        finite.expand(b);
+    }
+    BBox surfaces = scene.surfaceSet->bounds();
+    if (!surfaces.empty()) {
+        t.bounds.expand(surfaces);
+        finite.expand(surfaces);
+    }
+    if (t.unbounded) {
+        // Fog fills all space: cover what the scene has that is finite.
+        for (const Light& l : scene.lights) {
+            const LightDesc& d = l.desc();
+            if (d.type == LightDesc::Type::Point || d.type == LightDesc::Type::Spot || d.type == LightDesc::Type::Sphere)
+                finite.expand(d.position);
+            if (d.type == LightDesc::Type::CollimatedQuad) finite.expand(d.center);
+        }
+        finite.expand(scene.desc.camera.position);
+        finite.expand(scene.desc.camera.lookAt);
+        Vec3 pad = (finite.hi - finite.lo) * 0.05f + Vec3(1e-3f * std::max(1.f, scene.sceneScale));
+        finite.lo -= pad;
+        finite.hi += pad;
+        t.bounds = finite;
+    }
+    return t;
+}
+
+PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
+    auto start = std::chrono::steady_clock::now();
+    PhotonSet set;
+    if (paths == 0 || !sceneScatters(scene)) return set;
+    const PhotonTarget target = photonTarget(scene);
+    if (target.bounds.empty()) return set;
+
+    std::vector<PhotonSource> sources;
+    for (const Light& l : scene.lights) {
+        PhotonSource s{PhotonEmitter::forLight(l, target), nullptr, -1, Color(0), 0, 0};
+        s.power = s.emitter.power();
+        if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
+    }
+    if (maxComponent(scene.background) > 0) {
+        PhotonSource s{PhotonEmitter::forEnvironment(scene.background, target), nullptr, -1, Color(0), 0, 0};
+        s.power = s.emitter.power();
+        if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
+    }
+    for (size_t mi = 0; mi < scene.media.size(); ++mi) {
+        const Medium& m = *scene.media[mi];
+        if (!m.hasEmission) continue;
+        auto sampler = m.makeEmissionSampler();
+        if (!sampler) continue;
+        PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), 0, 0};
+        s.power = m.sigma_a * m.emissionColor * (4 * Pi * sampler->integralEstimate());
+        s.volume = std::move(sampler);
+        if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
+    }
+    if (sources.empty()) return set;
+
+    // Paths per source in proportion to power (every source that can reach
+    // the target gets at least one), as contiguous index ranges.
+    double total = 0;
+    for (const auto& s : sources) total += average(s.power);
+    size_t assigned = 0;
+    for (size_t i = 0; i < sources.size(); ++i) {
+        double share = average(sources[i].power) / total * double(paths);
+        sources[i].count = std::max<size_t>(1, size_t(std::llround(share)));
+        assigned += sources[i].count;
+    }
+    // Fix rounding on the largest source so the total is exactly `paths`.
+    size_t largest = 0;
+    for (size_t i = 1; i < sources.size(); ++i)
+        if (sources[i].count > sources[largest].count) largest = i;
+    if (assigned > paths && sources[largest].count > assigned - paths) sources[largest].count -= assigned - paths;
+    else if (assigned < paths) sources[largest].count += paths - assigned;
+    size_t first = 0;
+    for (auto& s : sources) {
+        s.first = first;
+        first += s.count;
+        set.emittedPower += s.power;
+    }
+    set.paths = first;
+
+    PhotonTracer tracer(scene, seed);
+    const size_t chunks = (set.paths + ChunkPaths - 1) / ChunkPaths;
+    std::vector<std::vector<Photon>> perChunk(chunks);
+    tbb::enumerable_thread_specific<ThreadContext> contexts([&] { return ThreadContext(scene); });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& r) {
+        ThreadContext& ctx = contexts.local();
+        for (size_t c = r.begin(); c < r.end(); ++c) {
+            size_t begin = c * ChunkPaths, end = std::min(set.paths, begin + ChunkPaths);
+            auto& out = perChunk[c];
+            out.reserve((end - begin) * 2);
+            size_t si = 0;
+            for (size_t i = begin; i < end; ++i) {
+                while (i >= sources[si].first + sources[si].count) ++si;
+                tracer.tracePath(ctx, sources[si], i, out);
+            }
+        }
+    });
+    size_t n = 0;
+    for (const auto& v : perChunk) n += v.size();
+    set.photons.reserve(n);
+    for (auto& v : perChunk) {
+        set.photons.insert(set.photons.end(), v.begin(), v.end());
+        std::vector<Photon>().swap(v);
+    }
+    for (const Photon& p : set.photons) set.directCount += p.isDirect();
+    set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return set;
+}
+
+}  // namespace vdbmarch
