@@ -253,7 +253,7 @@ RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_
             size_t n = map.nearest(cache.cellCenter(cache.cells[c]), kk, idx.data(), d2.data());
             if (n == 0 || !(d2[n - 1] > 0)) continue;
             float* f = &cache.coefficients[c * size_t(count)];
-            for (size_t i = 0; i < n; ++i) {
+            for (size_t i = 0; i + 1 < n; ++i) {  // the farthest only sets the radius
                 const Photon& p = map[idx[i]];
                 float weight = average(p.weight);
                 if (order == 0) {

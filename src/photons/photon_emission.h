@@ -7,7 +7,9 @@
 // photons carry across it equals the light's true flux across it (the light
 // as Light::sample sees it, ignoring occlusion, which the tracer handles).
 // power() is the exact expectation of out.power (a missed sample counts as
-// zero), so it can be used to share a photon budget among emitters.
+// zero; for a clipped spot it comes from a quadrature accurate to ~1e-10), so
+// it can be used to share a photon budget among emitters. Photons that miss
+// still count in N.
 #pragma once
 
 #include "core/math.h"
@@ -23,7 +25,8 @@ namespace vdbmarch {
 // just outside its bounding sphere, so whatever lies upstream of that disc
 // receives nothing from them).
 // A bounded target whose box is empty means nothing can scatter: every
-// emitter reports zero power. A box that is not finite counts as unbounded.
+// emitter reports zero power. A box that is not finite counts as unbounded
+// for the light-only emitters and gives the disc emitters zero power.
 struct PhotonTarget {
     BBox bounds;
     bool unbounded = false;

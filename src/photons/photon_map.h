@@ -33,20 +33,25 @@ public:
     // the k nearest photons, dV the sphere that holds them. The weights of
     // stored photons are Phi_p / sigma_t(x_p); wo is the direction the light
     // leaves in (towards the viewer), `phase(cos)` the phase function (a
-    // Color) with cos between a photon's travel direction and wo.
+    // Color) with cos between a photon's travel direction and wo. `radius`,
+    // when given, receives the radius of the gathering sphere.
     template <typename Phase>
-    Color estimateLi(const Vec3& x, const Vec3& wo, size_t k, Phase&& phase) const {
+    Color estimateLi(const Vec3& x, const Vec3& wo, size_t k, Phase&& phase, float* radius = nullptr) const {
         constexpr size_t MaxK = 1024;
         uint32_t idx[MaxK];
         float d2[MaxK];
         size_t n = nearest(x, k < MaxK ? k : MaxK, idx, d2);
         if (n == 0) return Color(0);
+        // The farthest photon only sets the radius: summing the k - 1 inside
+        // the sphere makes the estimate unbiased where photons are uniform
+        // (docs/method.md).
         Color sum(0);
-        for (size_t i = 0; i < n; ++i) {
+        for (size_t i = 0; i + 1 < n; ++i) {
             const Photon& p = mPhotons[idx[i]];
             sum += p.weight * phase(dot(p.travelDirection(), wo));
         }
         float r2 = d2[n - 1];
+        if (radius) *radius = std::sqrt(r2);
         if (!(r2 > 0)) return Color(0);
         return sum / (4.f / 3.f * Pi * r2 * std::sqrt(r2));
     }

@@ -287,6 +287,7 @@ TEST(PhotonEmissionSpot, PartialOverlapPowerIsMean) {
         {{0, 8, 0}, {0.45f, -1, 0}, 30, 25},  // target narrower, spot edge across it
         {{0, 8, 0}, {0.45f, -1, 0}, 30, 0},   // same, hard edge
         {{2, 2, 2}, {-1, -1, -1}, 80, 60},    // wide falloff band across the target
+        {{0, 3000, 0}, {0.0005f, -1, 0}, 0.05f, 0.01f},  // hair-thin and far: float cosines would bias it
     };
     int seed = 10;
     for (const Case& c : cases) {

@@ -1,0 +1,193 @@
+// The photon map's in-scattered radiance (eq. 4, with photons stored at
+// every real collision with weight Phi / sigma_t) against independent
+// truths: the closed form of single scattering from a point light, and the
+// unbiased reference path tracer for the multiply scattered light, for an
+// isotropic and a strongly forward-scattering medium.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include <tbb/task_arena.h>
+
+#include "core/sampling.h"
+#include "marchers/marcher.h"
+#include "photons/photon_map.h"
+#include "photons/photon_tracer.h"
+#include "test_helpers.h"
+
+namespace vdbmarch {
+namespace {
+
+using testing::sceneFromJson;
+
+constexpr float SigmaA = 0.25f, SigmaS = 1.f, Intensity = 10.f;
+const Vec3 LightPos(0, 3, 0);
+
+// Unit-radius-ish box of homogeneous medium under a point light.
+std::string boxScene(float g, int maxDepth) {
+    return str(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [10, 10, 10]}],
+        "media": [{"name": "m", "type": "homogeneous", "sigma_a": [0.25, 0.25, 0.25], "sigma_s": [1, 1, 1],
+                   "g": )", g, R"(, "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}],
+        "render": {"max_depth": )", maxDepth, R"(, "seed": 3}})");
+}
+
+// Light that reaches x straight from the point light: p I T / d^2.
+float directLi(const Vec3& x, const Vec3& wo, float g) {
+    Vec3 travel = x - LightPos;
+    float d = length(travel);
+    travel = travel / d;
+    // The segment inside the box ends at its top face y = 1 (probes lie under the light).
+    float inside = (1 - x.y) / -travel.y;
+    return hgPhase(dot(travel, wo), g) * Intensity / (d * d) * std::exp(-(SigmaA + SigmaS) * inside);
+}
+
+// The uniform-kernel estimate sees L_i averaged over its gathering sphere:
+// the same average of the closed form (deterministic quadrature points), so
+// the comparison tests the normalisation, not the kernel's blur.
+float directLiOverBall(const Vec3& x, const Vec3& wo, float g, float radius) {
+    double sum = 0;
+    int n = 0;
+    Rng rng(4242);
+    while (n < 20000) {
+        Vec3 u(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1);
+        if (lengthSquared(u) > 1) continue;
+        sum += directLi(x + u * radius, wo, g);
+        ++n;
+    }
+    return float(sum / n);
+}
+
+struct Estimate {
+    double mean = 0, stdError = 0;
+};
+
+Estimate meanAndError(const std::vector<double>& v) {
+    double m = 0, s = 0;
+    for (double x : v) m += x;
+    m /= double(v.size());
+    for (double x : v) s += (x - m) * (x - m);
+    return {m, std::sqrt(s / double(v.size() - 1) / double(v.size()))};
+}
+
+// L_i scattered at least once before x (up to depth - 1 events), by the
+// reference tracer: phase-sample the light's travel direction t' around wo
+// and take the radiance arriving along it.
+Estimate referenceIndirect(const Scene& scene, const Vec3& x, const Vec3& wo, float g, int samples) {
+    auto tracer = makeMarcher("reference", scene);
+    ThreadContext ctx(scene);
+    std::vector<double> v;
+    v.reserve(size_t(samples));
+    for (int i = 0; i < samples; ++i) {
+        Rng rng(hashValues(77, uint64_t(i)));
+        Vec3 travel = directionAround(wo, sampleHgCosTheta(rng.uniform(), g), rng.uniform());
+        v.push_back(average(tracer->radiance(Ray{x, -travel}, rng, ctx).L));
+    }
+    return meanAndError(v);
+}
+
+void checkAgainstTruth(float g) {
+    const int depth = 3;
+    auto scene = sceneFromJson(boxScene(g, depth));
+    auto shorter = sceneFromJson(boxScene(g, depth - 1));  // paths that end one event before x
+    const Vec3 probes[] = {{0.2f, 0.1f, -0.3f}, {-0.4f, -0.5f, 0.3f}};
+    const Vec3 dirs[] = {{0, -1, 0}, {1, 0, 0}, normalize(Vec3(0, 1, 1))};
+    const int seeds = 8;
+    const size_t k = 100;
+    // Independent photon maps give the estimate's standard error.
+    std::vector<std::vector<double>> direct(6), indirect(6), smoothedTruth(6);
+    for (int s = 0; s < seeds; ++s) {
+        PhotonSet set = tracePhotons(*scene, 100000, uint64_t(100 + s));
+        std::vector<Photon> d, n;
+        for (const Photon& p : set.photons) (p.isDirect() ? d : n).push_back(p);
+        PhotonMap directMap(std::move(d)), indirectMap(std::move(n));
+        auto phase = [&](float c) { return Color(hgPhase(c, g)); };
+        for (int pi = 0; pi < 2; ++pi)
+            for (int di = 0; di < 3; ++di) {
+                float r = 0;
+                direct[size_t(pi * 3 + di)].push_back(
+                    average(directMap.estimateLi(probes[pi], dirs[di], k, phase, &r)));
+                smoothedTruth[size_t(pi * 3 + di)].push_back(directLiOverBall(probes[pi], dirs[di], g, r));
+                indirect[size_t(pi * 3 + di)].push_back(
+                    average(indirectMap.estimateLi(probes[pi], dirs[di], k, phase)));
+            }
+    }
+    for (int pi = 0; pi < 2; ++pi)
+        for (int di = 0; di < 3; ++di) {
+            const Vec3& x = probes[pi];
+            const Vec3& wo = dirs[di];
+            Estimate pd = meanAndError(direct[size_t(pi * 3 + di)]);
+            double truth = meanAndError(smoothedTruth[size_t(pi * 3 + di)]).mean;
+            EXPECT_NEAR(pd.mean, truth, 4 * pd.stdError)
+                << "direct photons, g " << g << " probe " << pi << " direction " << di << " (SE " << pd.stdError << ")";
+            Estimate pn = meanAndError(indirect[size_t(pi * 3 + di)]);
+            Estimate ref = referenceIndirect(*shorter, x, wo, g, 20000);
+            double se = std::sqrt(pn.stdError * pn.stdError + ref.stdError * ref.stdError);
+            EXPECT_NEAR(pn.mean, ref.mean, 4 * se) << "scattered photons vs reference, g " << g << " probe " << pi
+                                                   << " direction " << di;
+            EXPECT_GT(ref.mean, 0);
+            if (std::getenv("VDBMARCH_VERBOSE"))
+                std::printf("g %.2f probe %d dir %d: direct %.4g +- %.2g (truth %.4g, point %.4g); scattered %.4g +- %.2g, reference %.4g +- %.2g\n", g, pi, di, pd.mean, pd.stdError, truth, directLi(x, wo, g), pn.mean, pn.stdError, ref.mean, ref.stdError);
+        }
+}
+
+TEST(PhotonMapAccuracy, IsotropicMatchesClosedFormAndReference) { checkAgainstTruth(0.f); }
+
+TEST(PhotonMapAccuracy, ForwardScatteringMatchesClosedFormAndReference) { checkAgainstTruth(0.9f); }
+
+TEST(PhotonTracing, DeterministicForAnyThreadCount) {
+    auto scene = sceneFromJson(boxScene(0.5f, 4));
+    PhotonSet one, two;
+    tbb::task_arena(1).execute([&] { one = tracePhotons(*scene, 20000, 5); });
+    tbb::task_arena(2).execute([&] { two = tracePhotons(*scene, 20000, 5); });
+    ASSERT_GT(one.photons.size(), 10000u);
+    ASSERT_EQ(one.photons.size(), two.photons.size());
+    EXPECT_EQ(0, std::memcmp(one.photons.data(), two.photons.data(), one.photons.size() * sizeof(Photon)));
+}
+
+TEST(PhotonTracing, StoresNothingWithoutScattering) {
+    auto scene = sceneFromJson(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [10, 10, 10]}],
+        "media": [{"name": "m", "type": "homogeneous", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0],
+                   "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}]})");
+    EXPECT_FALSE(sceneScatters(*scene));
+    PhotonSet set = tracePhotons(*scene, 1000, 1);
+    EXPECT_EQ(set.paths, 0u);
+    EXPECT_TRUE(set.photons.empty());
+}
+
+TEST(PhotonTracing, LightsThatCannotReachAMediumEmitNothing) {
+    // A spot aimed away from the medium shares no photons with the point light.
+    auto scene = sceneFromJson(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [1, 1, 1]},
+                   {"type": "spot", "position": [0, 3, 0], "direction": [0, 1, 0], "intensity": [1000, 1000, 1000],
+                    "cone_deg": 20}],
+        "media": [{"name": "m", "type": "homogeneous", "sigma_a": [0, 0, 0], "sigma_s": [1, 1, 1],
+                   "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}]})");
+    PhotonSet set = tracePhotons(*scene, 5000, 1);
+    EXPECT_EQ(set.paths, 5000u);
+    // All the emitted power is the point light's, in its cone towards the box.
+    Color pointPower = PhotonEmitter::forLight(scene->lights[0], photonTarget(*scene)).power();
+    EXPECT_EQ(set.emittedPower.x, pointPower.x);
+    EXPECT_LT(pointPower.x, 4 * Pi);
+    EXPECT_GT(set.photons.size(), 0u);
+}
+
+TEST(PhotonStorage, CompactDirectionAndPhase) {
+    EXPECT_EQ(sizeof(Photon), 32u);
+    Rng rng(9);
+    for (int i = 0; i < 10000; ++i) {
+        Vec3 d = sampleUniformSphere(rng.uniform(), rng.uniform());
+        EXPECT_LT(length(decodeDirection(encodeDirection(d)) - d), 1e-4f);  // ~3e-5 rad quantisation
+    }
+    for (float g : {-0.999f, -0.3f, 0.f, 0.85f, 0.999f}) {
+        Photon p{};
+        p.flags = Photon::packFlags(true, g);
+        EXPECT_TRUE(p.isDirect());
+        EXPECT_NEAR(p.g(), g, 1.f / 32767);
+    }
+}
+
+}  // namespace
+}  // namespace vdbmarch
