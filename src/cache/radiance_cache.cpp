@@ -37,6 +37,50 @@ T metaValue(const openvdb::GridBase& g, const std::string& key, const std::strin
     return m->value();
 }
 
+// A trailer after the VDB data (OpenVDB readers ignore trailing bytes): a tag
+// and the FNV-1a hash of everything before it, so a damaged file is refused
+// before OpenVDB parses it (random damage can make that parse very slow).
+const std::string ChecksumTag = "\nvdbmarch-fnv1a64:";
+constexpr size_t ChecksumDigits = 16;
+
+uint64_t fnv1a(const char* data, size_t n) {
+    uint64_t h = 1469598103934665603ULL;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= static_cast<unsigned char>(data[i]);
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+std::string hex64(uint64_t v) {
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+    return buf;
+}
+
+void appendChecksum(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.eof() && in.fail()) throw IoError(str(path, ": cannot read back the cache to checksum it"));
+    std::ofstream out(path, std::ios::binary | std::ios::app);
+    out << ChecksumTag << hex64(fnv1a(bytes.data(), bytes.size()));
+    if (!out.flush()) throw IoError(str(path, ": cannot write the cache checksum: ", std::strerror(errno)));
+}
+
+// True when the file ends with a matching trailer; false when it has none
+// (re-saved by another VDB tool); throws when the trailer does not match.
+bool verifyChecksum(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const size_t trailer = ChecksumTag.size() + ChecksumDigits;
+    if (bytes.size() < trailer || bytes.compare(bytes.size() - trailer, ChecksumTag.size(), ChecksumTag) != 0)
+        return false;
+    std::string stored = bytes.substr(bytes.size() - ChecksumDigits);
+    if (stored != hex64(fnv1a(bytes.data(), bytes.size() - trailer)))
+        throw InputError(str(path, ": checksum mismatch: the cache file is damaged; bake it again"));
+    return true;
+}
+
 }  // namespace
 
 struct RadianceCache::Index {
@@ -158,6 +202,7 @@ void RadianceCache::save(const std::string& path) const {
     } catch (const openvdb::Exception& e) {
         throw IoError(str(path, ": cannot write the cache: ", e.what()));
     }
+    appendChecksum(out.tempPath());
     out.commit();
 }
 
@@ -201,6 +246,9 @@ RadianceCache RadianceCache::load(const std::string& path) {
         std::ifstream probe(path, std::ios::binary);
         if (!probe) throw IoError(str(path, ": cannot open cache file: ", std::strerror(errno)));
     }
+    if (!verifyChecksum(path))
+        warn(str(path, ": no vdbmarch checksum (the file was truncated, or re-saved by another VDB tool): "
+                       "loading it unverified"));
     openvdb::GridPtrVecPtr grids;
     try {
         openvdb::io::File file(path);

@@ -1,0 +1,233 @@
+// The radiance cache: eq. 27 at the cell centres equals the photon map's
+// eq. 4 with the truncated Legendre series of the phase function; the grid
+// rule; the adaptive hierarchy's lookups; isotropic and non-scattering
+// media; and the .vdb file: round trip, and clear errors for truncated,
+// corrupted, foreign and other-scene files.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "cache/bake.h"
+#include "cache/sh.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "test_helpers.h"
+
+namespace vdbmarch {
+namespace {
+
+using testing::sceneFromJson;
+using testing::tempDir;
+
+std::string spotScene(float g, bool adaptive) {
+    return str(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "lights": [{"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "intensity": [20, 20, 20],
+                    "cone_deg": 8, "falloff_deg": 2}],
+        "media": [{"name": "m", "type": "homogeneous", "sigma_a": [0.1, 0.1, 0.1], "sigma_s": [1, 1, 1],
+                   "g": )", g, R"(, "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}],
+        "photons": {"count": 60000, "k": 40},
+        "cache": {"sh_order": 3, "quality": 1, "adaptive": )", adaptive ? "true" : "false", R"(},
+        "render": {"max_depth": 2, "seed": 1}})");
+}
+
+BakeResult bake(const Scene& s) { return bakeRadianceCache(s, s.desc.photons, s.desc.cache); }
+
+TEST(RadianceCache, CoefficientsAreEq27OfTheNearestPhotons) {
+    auto scene = sceneFromJson(spotScene(0.7f, false));
+    BakeResult r = bake(*scene);
+    const RadianceCache& c = r.cache;
+    ASSERT_EQ(c.info.shOrder, 3);
+    ASSERT_GT(c.cells.size(), 100u);
+    const int K = c.info.shOrder;
+    const float g = 0.7f;
+    // Truncated Legendre series of HG: what eq. 27 keeps of the phase function.
+    auto truncated = [&](float cosTheta) {
+        double P[MaxShOrder + 1];
+        legendrePolynomials(K, cosTheta, P);
+        double p = 0;
+        for (int l = 0; l <= K; ++l) p += (2 * l + 1) / (4 * M_PI) * std::pow(g, l) * P[l];
+        return Color(float(p));
+    };
+    float Y[shCount(MaxShOrder)];
+    Rng rng(3);
+    int checked = 0;
+    for (size_t cell = 0; cell < c.cells.size(); cell += c.cells.size() / 40) {
+        Vec3 wo = sampleUniformSphere(rng.uniform(), rng.uniform());
+        evalSh(K, wo, Y);
+        float cached = evalShSum(c.coefficientCount(), c.cellCoefficients(cell), Y);
+        float direct = average(r.photons->estimateLi(c.cellCenter(c.cells[cell]), wo, size_t(c.info.k), truncated));
+        // Float rounding relative to the largest the sum can be: the
+        // truncated phase is at most sum_l (2l+1) g^l / (4 pi) < 1, so each
+        // term is below 4 pi times the cell's mean f_00 Y_00.
+        float bound = 4 * Pi * c.cellCoefficients(cell)[0] * 0.2820948f;
+        EXPECT_NEAR(cached, direct, 1e-5f * bound) << "cell " << cell;
+        ++checked;
+    }
+    EXPECT_GE(checked, 40);
+}
+
+TEST(RadianceCache, UniformGridFollowsThePapersRule) {
+    auto scene = sceneFromJson(spotScene(0.f, false));
+    BakeResult r = bake(*scene);
+    const RadianceCache& c = r.cache;
+    // s = (a N / (k V))^(1/3) on the medium's volume V = 8: the cells cover
+    // the box, so their count is about a N / k (up to the partial cells).
+    double expected = std::cbrt(40.0 * 8 / (1.0 * double(c.info.photons)));
+    EXPECT_NEAR(c.baseCell, expected, 0.15 * expected);
+    double cellsPerPhoton = double(c.cells.size()) * 40 / double(c.info.photons);
+    EXPECT_GT(cellsPerPhoton, 0.7);
+    EXPECT_LT(cellsPerPhoton, 2.0);
+}
+
+TEST(RadianceCache, IsotropicMediaStoreOneCoefficient) {
+    auto scene = sceneFromJson(spotScene(0.f, false));
+    BakeResult r = bake(*scene);
+    EXPECT_EQ(r.cache.info.shOrder, 0);
+    EXPECT_EQ(r.cache.info.requestedOrder, 3);
+    EXPECT_EQ(r.cache.coefficientCount(), 1);
+    EXPECT_EQ(r.cache.coefficients.size(), r.cache.cells.size());
+}
+
+TEST(RadianceCache, NonScatteringSceneHasNothingToBake) {
+    auto scene = sceneFromJson(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [1, 1, 1]}],
+        "media": [{"name": "m", "type": "homogeneous", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0],
+                   "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}]})");
+    try {
+        bake(*scene);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("no medium scatters"), std::string::npos) << e.what();
+    }
+}
+
+TEST(RadianceCache, AdaptiveCellsTileSpaceAndRefineWherePhotonsAreDense) {
+    auto scene = sceneFromJson(spotScene(0.7f, true));
+    BakeResult r = bake(*scene);
+    const RadianceCache& c = r.cache;
+    ASSERT_GT(c.levels, 2);
+    EXPECT_GT(c.cellsAtLevel(c.levels - 1), 0u);  // the beam is refined to the finest level
+    EXPECT_GT(c.cellsAtLevel(0), 0u);              // the dark corners stay coarse
+    // Every cell is found at its own centre (no finer cell hides it), and
+    // points anywhere in the medium find a cell that contains them.
+    RadianceCache::Query q(c);
+    for (size_t i = 0; i < c.cells.size(); ++i) ASSERT_EQ(q.find(c.cellCenter(c.cells[i])), int64_t(i));
+    Rng rng(5);
+    for (int i = 0; i < 20000; ++i) {
+        Vec3 p(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1);
+        int64_t cell = q.find(p);
+        ASSERT_GE(cell, 0);
+        const CacheCell& cc = c.cells[size_t(cell)];
+        Vec3 d = p - c.cellCenter(cc);
+        float h = c.cellSize(cc.level) * 0.5f * 1.0001f;
+        ASSERT_TRUE(std::fabs(d.x) <= h && std::fabs(d.y) <= h && std::fabs(d.z) <= h);
+    }
+    // Cells on the beam axis are finer than cells in the corners.
+    int64_t axis = q.find(Vec3(0, 0.5f, 0)), corner = q.find(Vec3(-0.95f, -0.95f, -0.95f));
+    EXPECT_GT(c.cells[size_t(axis)].level, c.cells[size_t(corner)].level);
+}
+
+TEST(RadianceCacheFile, RoundTripKeepsEveryCellAndCoefficient) {
+    for (bool adaptive : {false, true}) {
+        auto scene = sceneFromJson(spotScene(0.7f, adaptive));
+        BakeResult r = bake(*scene);
+        std::string path = tempDir() + str("/roundtrip", adaptive, ".vdb");
+        r.cache.save(path);
+        RadianceCache back = RadianceCache::load(path);
+        ASSERT_EQ(back.cells.size(), r.cache.cells.size());
+        EXPECT_EQ(back.levels, r.cache.levels);
+        EXPECT_EQ(back.info.sceneHash, r.cache.info.sceneHash);
+        EXPECT_EQ(back.info.photons, r.cache.info.photons);
+        RadianceCache::Query q(back);
+        for (size_t i = 0; i < r.cache.cells.size(); ++i) {
+            int64_t j = q.find(r.cache.cellCenter(r.cache.cells[i]));
+            ASSERT_GE(j, 0);
+            for (int k = 0; k < r.cache.coefficientCount(); ++k)
+                ASSERT_EQ(back.cellCoefficients(size_t(j))[k], r.cache.cellCoefficients(i)[k]);
+        }
+        EXPECT_NO_THROW(checkCacheMatchesScene(back, *scene, path, false));
+    }
+}
+
+TEST(RadianceCacheFile, RefusesAnotherScene) {
+    auto scene = sceneFromJson(spotScene(0.7f, false));
+    BakeResult r = bake(*scene);
+    auto other = sceneFromJson(spotScene(0.5f, false));
+    try {
+        checkCacheMatchesScene(r.cache, *other, "c.vdb", false);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("another scene"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
+    }
+    setWarningsQuiet(true);
+    EXPECT_NO_THROW(checkCacheMatchesScene(r.cache, *other, "c.vdb", true));
+    setWarningsQuiet(false);
+    // The camera and render settings do not change the light field.
+    std::string moved = spotScene(0.7f, false);
+    moved.replace(moved.find("[0, 0, 5]"), 9, "[1, 2, 6]");
+    EXPECT_NO_THROW(checkCacheMatchesScene(r.cache, *sceneFromJson(moved), "c.vdb", false));
+}
+
+void expectInputError(const std::string& path, const std::string& fragment) {
+    try {
+        RadianceCache::load(path);
+        FAIL() << "expected an error loading " << path;
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+}
+
+TEST(RadianceCacheFile, TruncatedOrCorruptedFilesFailCleanly) {
+    setWarningsQuiet(true);  // truncated files lose their checksum trailer
+    auto scene = sceneFromJson(spotScene(0.7f, true));
+    BakeResult r = bake(*scene);
+    std::string good = tempDir() + "/good.vdb";
+    r.cache.save(good);
+    std::ifstream in(good, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 1000u);
+    // Truncations at many lengths, and bytes overwritten with garbage: each
+    // is an InputError naming the file (the checksum trailer catches the
+    // damage before OpenVDB parses it), never a crash.
+    Rng rng(11);
+    for (int trial = 0; trial < 24; ++trial) {
+        std::string damaged = bytes;
+        if (trial < 12) {
+            damaged.resize(size_t(double(bytes.size()) * (trial + 0.5) / 12.5));
+        } else {
+            size_t at = size_t(rng.uniform() * float(bytes.size() - 64));
+            for (size_t i = 0; i < 32; ++i) damaged[at + i] = char(rng.next() & 0xff);
+        }
+        std::string path = tempDir() + str("/damaged", trial, ".vdb");
+        std::ofstream(path, std::ios::binary) << damaged;
+        try {
+            RadianceCache::load(path);
+            ADD_FAILURE() << "trial " << trial << ": a damaged cache loaded";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        }
+    }
+    std::string missing = tempDir() + "/does_not_exist.vdb";
+    EXPECT_THROW(RadianceCache::load(missing), IoError);
+    // A VDB that is not a cache (a density grid), and a cache of another format version.
+    std::string density = tempDir() + "/density.vdb";
+    testing::writeBoxGrid(density, openvdb::Coord(0), openvdb::Coord(3), 1.f, 0.1);
+    expectInputError(density, "not a vdbmarch cache");
+    openvdb::io::File file(good);
+    file.open();
+    openvdb::GridPtrVecPtr grids = file.getGrids();
+    file.close();
+    for (auto& g : *grids) g->insertMeta("vdbmarch_cache_version", openvdb::Int32Metadata(99));
+    std::string future = tempDir() + "/future.vdb";
+    openvdb::io::File(future).write(*grids);
+    expectInputError(future, "version 99");
+    setWarningsQuiet(false);
+}
+
+}  // namespace
+}  // namespace vdbmarch
