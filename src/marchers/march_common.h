@@ -4,6 +4,7 @@
 // estimation to every light, plus the background as a constant environment).
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -71,6 +72,37 @@ Vec3 sampleDielectric(const Vec3& d, const Vec3& n, float ior, float u, bool& re
 // its HG lobe) around the travel direction d. Multiplies `weight` by f / pdf
 // per channel (1 for a single medium) and sets the direction's pdf.
 Vec3 samplePhaseMixture(const MediumPoint& mp, const Vec3& d, Rng& rng, Color& weight, float& pdf);
+
+// Delta tracking along [0, tEnd) of `ray` in `region`: tentative collisions
+// are drawn at rate sigma_maj against the local majorants (walked lazily for
+// a single medium, so blocks past the first real collision are never
+// visited), and collide(x, sigmaMaj) is called at each until it returns false.
+template <typename Collide>
+void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int channel, Rng& rng, Collide&& collide) {
+    // `ray` is a copy: collide() may replace the caller's ray when it scatters.
+    auto track = [&](const MajorantSegment& seg) {
+        const float sigmaMaj = seg.maxDensity;
+        if (!(sigmaMaj > 0)) return true;
+        double t = seg.t0;
+        while (true) {
+            t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
+            if (t >= seg.t1) return true;
+            if (!collide(ray.at(t), sigmaMaj)) return false;
+        }
+    };
+    const auto& media = ctx.scene.regions[size_t(region)].media;
+    if (media.size() == 1 && !ctx.scene.desc.render.globalMajorant) {
+        const Medium& m = *ctx.scene.media[size_t(media[0])];
+        const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
+        ctx.queries[size_t(media[0])]->forEachMajorant(ray, 0.f, tEnd, [&](const MajorantSegment& s) {
+            return track({s.t0, s.t1, s.maxDensity * k});
+        });
+    } else if (!media.empty()) {
+        regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);
+        for (const auto& seg : ctx.majorants)
+            if (!track(seg)) break;
+    }
+}
 
 // Transmittance from p along direction wi over distance `dist` (Infinity for
 // the environment/directional lights), starting in `region`. Interfaces are

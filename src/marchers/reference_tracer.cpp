@@ -169,61 +169,38 @@ private:
             int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
             float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
 
-            // Delta tracking to the next real collision, or to tEnd. `track`
-            // handles one majorant segment; it returns false once the path
-            // scattered or was absorbed.
+            // Delta tracking to the next real collision, or to tEnd; the
+            // collision callback returns false once the path scattered or was absorbed.
             bool scattered = false;
-            auto track = [&](const MajorantSegment& seg) {
-                const float sigmaMaj = seg.maxDensity;
-                if (!(sigmaMaj > 0)) return true;
-                double t = seg.t0;
-                while (true) {
-                    t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
-                    if (t >= seg.t1) return true;
-                    Vec3 x = ray.at(t);
-                    evalMedia(ctx, region, x, mp);
-                    ++ctx.counters.marchSamples;
-                    // Emission: sigma_a L_e / sigma_maj at every tentative collision.
-                    if (!isBlack(mp.emission)) L += beta * mp.sigma_a * mp.emission / sigmaMaj;
-                    float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
-                    float u = rng.uniform() * sigmaMaj;
-                    if (u < sa) {
-                        beta = Color(0);  // absorbed
-                        return false;
-                    }
-                    if (u >= sa + ss) continue;  // null collision
-                    // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
-                    beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
-                    ++depth;
-                    if (depth > maxDepth) {
-                        beta = Color(0);
-                        return false;
-                    }
-                    L += beta * nextEvent(ctx, region, x, ray.d, &mp, nullptr, Color(0), rng);
-                    float pdf;
-                    Vec3 wi = samplePhaseMixture(mp, ray.d, rng, beta, pdf);
-                    lastPdf = pdf;
-                    specular = false;
-                    lastPoint = x;
-                    ray = Ray{x, wi};
-                    scattered = true;
+            deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+                evalMedia(ctx, region, x, mp);
+                ++ctx.counters.marchSamples;
+                // Emission: sigma_a L_e / sigma_maj at every tentative collision.
+                if (!isBlack(mp.emission)) L += beta * mp.sigma_a * mp.emission / sigmaMaj;
+                float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
+                float u = rng.uniform() * sigmaMaj;
+                if (u < sa) {
+                    beta = Color(0);  // absorbed
                     return false;
                 }
-            };
-            const auto& regionMedia = scene.regions[size_t(region)].media;
-            if (regionMedia.size() == 1 && !scene.desc.render.globalMajorant) {
-                // Lazily: blocks past the first real collision are never visited.
-                const Medium& m = *scene.media[size_t(regionMedia[0])];
-                const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
-                const Ray segmentRay = ray;  // `track` replaces ray when it scatters
-                ctx.queries[size_t(regionMedia[0])]->forEachMajorant(segmentRay, 0.f, tEnd, [&](const MajorantSegment& s) {
-                    return track({s.t0, s.t1, s.maxDensity * k});
-                });
-            } else if (!regionMedia.empty()) {
-                regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);
-                for (const auto& seg : ctx.majorants)
-                    if (!track(seg)) break;
-            }
+                if (u >= sa + ss) return true;  // null collision
+                // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
+                beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+                ++depth;
+                if (depth > maxDepth) {
+                    beta = Color(0);
+                    return false;
+                }
+                L += beta * nextEvent(ctx, region, x, ray.d, &mp, nullptr, Color(0), rng);
+                float pdf;
+                Vec3 wi = samplePhaseMixture(mp, ray.d, rng, beta, pdf);
+                lastPdf = pdf;
+                specular = false;
+                lastPoint = x;
+                ray = Ray{x, wi};
+                scattered = true;
+                return false;
+            });
             if (isBlack(beta)) return {channelOnly(L, channel), 0.f};
             if (scattered) {
                 if (!roulette(beta, depth, rng)) return {channelOnly(L, channel), 0.f};

@@ -91,55 +91,34 @@ private:
             // Delta tracking to the next real collision; the photon is stored
             // there, then scatters with probability albedo (Russian roulette).
             bool scattered = false, ended = false;
-            auto track = [&](const MajorantSegment& seg) {
-                const float sigmaMaj = seg.maxDensity;
-                if (!(sigmaMaj > 0)) return true;
-                double t = seg.t0;
-                while (true) {
-                    t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
-                    if (t >= seg.t1) return true;
-                    Vec3 x = ray.at(t);
-                    evalMedia(ctx, region, x, mp);
-                    float sa = channel < 0 ? average(mp.sigma_a) : mp.sigma_a[channel];
-                    float ss = channel < 0 ? average(mp.sigma_s) : mp.sigma_s[channel];
-                    if (rng.uniform() * sigmaMaj >= sa + ss) continue;  // null collision
-                    float st = sa + ss;
-                    Photon ph;
-                    ph.position = x;
-                    ph.direction = encodeDirection(ray.d);
-                    ph.weight = power / st;  // grey extinction: sigma_t is the same in every channel
-                    float gMean = 0, ssSum = 0;
-                    for (int i = 0; i < mp.count; ++i) {
-                        gMean += average(mp.sigmaS[i]) * mp.g[i];
-                        ssSum += average(mp.sigmaS[i]);
-                    }
-                    ph.flags = Photon::packFlags(direct, ssSum > 0 ? gMean / ssSum : 0.f);
-                    out.push_back(ph);
-                    if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
-                        ended = true;
-                        return false;
-                    }
-                    if (channel < 0) power *= mp.sigma_s / ss;  // per-channel albedo over its mean
-                    float pdf;
-                    ray = Ray{x, samplePhaseMixture(mp, ray.d, rng, power, pdf)};
-                    direct = false;
-                    scattered = true;
+            deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+                evalMedia(ctx, region, x, mp);
+                float sa = channel < 0 ? average(mp.sigma_a) : mp.sigma_a[channel];
+                float ss = channel < 0 ? average(mp.sigma_s) : mp.sigma_s[channel];
+                if (rng.uniform() * sigmaMaj >= sa + ss) return true;  // null collision
+                float st = sa + ss;
+                Photon ph;
+                ph.position = x;
+                ph.direction = encodeDirection(ray.d);
+                ph.weight = power / st;  // grey extinction: sigma_t is the same in every channel
+                float gMean = 0, ssSum = 0;
+                for (int i = 0; i < mp.count; ++i) {
+                    gMean += average(mp.sigmaS[i]) * mp.g[i];
+                    ssSum += average(mp.sigmaS[i]);
+                }
+                ph.flags = Photon::packFlags(direct, ssSum > 0 ? gMean / ssSum : 0.f);
+                out.push_back(ph);
+                if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
+                    ended = true;
                     return false;
                 }
-            };
-            const auto& media = scene.regions[size_t(region)].media;
-            if (media.size() == 1) {
-                const Medium& m = *scene.media[size_t(media[0])];
-                const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
-                const Ray segmentRay = ray;
-                ctx.queries[size_t(media[0])]->forEachMajorant(segmentRay, 0.f, tEnd, [&](const MajorantSegment& s) {
-                    return track({s.t0, s.t1, s.maxDensity * k});
-                });
-            } else if (!media.empty()) {
-                regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);
-                for (const auto& seg : ctx.majorants)
-                    if (!track(seg)) break;
-            }
+                if (channel < 0) power *= mp.sigma_s / ss;  // per-channel albedo over its mean
+                float pdf;
+                ray = Ray{x, samplePhaseMixture(mp, ray.d, rng, power, pdf)};
+                direct = false;
+                scattered = true;
+                return false;
+            });
             if (ended) return;
             if (scattered) {
                 if (!std::isfinite(maxComponent(power))) return;
