@@ -130,6 +130,113 @@ TEST(RadianceCache, AdaptiveCellsTileSpaceAndRefineWherePhotonsAreDense) {
     EXPECT_GT(c.cells[size_t(axis)].level, c.cells[size_t(corner)].level);
 }
 
+// Section 3.4 / figure 4: where strong radiance fills a small region, the
+// adaptive cache resolves it better than a uniform cache of the same memory.
+// Truth is single scattering from the spot in closed form (max_depth 1: every
+// photon is direct) with the truncated Legendre phase that eq. 27 keeps, so
+// the error measured is the cache's spatial error (blur and noise) alone.
+// Figures for BENCHMARKS.md: VDBMARCH_VERBOSE=1 vdbmarch_accuracy_tests
+// --gtest_filter='*EqualStorage*'.
+struct CacheError {
+    double relL2 = 0, beamRelL2 = 0;  // sqrt(sum (cached - truth)^2 / sum truth^2)
+    size_t cells = 0, bytes = 0;
+};
+
+CacheError cacheError(const Scene& scene, const RadianceCache& c, float g) {
+    const int K = c.info.shOrder;
+    const Light& light = scene.lights[0];
+    const float sigmaT = 1.1f;
+    auto truth = [&](const Vec3& x, const Vec3& wo) {
+        LightSample ls;
+        if (!light.sample(x, 0.5f, 0.5f, ls)) return 0.0;
+        float inside = (1 - x.y) / ls.wi.y;  // the path to the light leaves the box at y = 1
+        double P[MaxShOrder + 1];
+        legendrePolynomials(K, dot(-ls.wi, wo), P);
+        double p = 0;
+        for (int l = 0; l <= K; ++l) p += (2 * l + 1) / (4 * M_PI) * std::pow(g, l) * P[l];
+        return p * double(average(ls.L)) * std::exp(-sigmaT * inside);
+    };
+    RadianceCache::Query q(c);
+    float Y[shCount(MaxShOrder)];
+    Rng rng(11);
+    double se = 0, s2 = 0, beamSe = 0, beamS2 = 0;
+    for (int i = 0; i < 200000; ++i) {
+        Vec3 x(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1);
+        Vec3 wo = sampleUniformSphere(rng.uniform(), rng.uniform());
+        double t = truth(x, wo);
+        int64_t cell = q.find(x);
+        evalSh(K, wo, Y);
+        double cached = cell < 0 ? 0.0 : evalShSum(c.coefficientCount(), c.cellCoefficients(size_t(cell)), Y);
+        se += (cached - t) * (cached - t);
+        s2 += t * t;
+        // The beam's edge: between 0.7 and 1.3 cone radii (8 degrees) from the axis.
+        float r = std::sqrt(x.x * x.x + x.z * x.z) / ((3 - x.y) * std::tan(8 * Pi / 180));
+        if (r > 0.7f && r < 1.3f) {
+            beamSe += (cached - t) * (cached - t);
+            beamS2 += t * t;
+        }
+    }
+    CacheError e;
+    e.relL2 = std::sqrt(se / s2);
+    e.beamRelL2 = std::sqrt(beamSe / beamS2);
+    e.cells = c.cells.size();
+    e.bytes = c.memoryBytes();
+    return e;
+}
+
+// A uniform cache from the same photons whose cell count (or, with `bytes`,
+// memory including the VDB index) matches `target`, by bisection on quality a.
+RadianceCache matchedUniformCache(const Scene& scene, const BakeResult& r, int k, size_t target, bool bytes) {
+    CacheSettings us = scene.desc.cache;
+    us.adaptive = false;
+    float lo = 0.01f, hi = 100.f;
+    RadianceCache best;
+    double bestGap = 1e30;
+    for (int it = 0; it < 16; ++it) {
+        us.quality = std::sqrt(lo * hi);
+        RadianceCache c = buildRadianceCache(scene, *r.photons, r.paths, us, k);
+        size_t size = bytes ? c.memoryBytes() : c.cells.size();
+        double gap = std::fabs(std::log(double(size) / double(target)));
+        if (gap < bestGap) bestGap = gap, best = std::move(c);
+        (size < target ? lo : hi) = us.quality;
+    }
+    return best;
+}
+
+TEST(RadianceCache, AdaptiveIsMoreAccurateThanUniformAtEqualStorage) {
+    const float g = 0.7f;
+    std::string json = spotScene(g, true);
+    json.replace(json.find("\"max_depth\": 2"), 14, "\"max_depth\": 1");
+    auto scene = sceneFromJson(json);
+    // VDBMARCH_VERBOSE adds a larger photon map for the benchmark table.
+    std::vector<int64_t> counts{30000, 120000};
+    if (std::getenv("VDBMARCH_VERBOSE")) counts.push_back(480000);
+    for (int64_t photons : counts) {
+        PhotonSettings ps = scene->desc.photons;
+        ps.count = photons;
+        BakeResult r = bakeRadianceCache(*scene, ps, scene->desc.cache);
+        ASSERT_TRUE(r.cache.info.adaptive);
+        ASSERT_EQ(r.directPhotons, r.photons->size());
+        CacheError adaptive = cacheError(*scene, r.cache, g);
+        CacheError sameCells = cacheError(*scene, matchedUniformCache(*scene, r, ps.k, adaptive.cells, false), g);
+        CacheError sameBytes = cacheError(*scene, matchedUniformCache(*scene, r, ps.k, adaptive.bytes, true), g);
+        EXPECT_NEAR(double(sameCells.cells), double(adaptive.cells), 0.1 * double(adaptive.cells));
+        EXPECT_LT(adaptive.relL2, sameCells.relL2) << photons << " photon paths";
+        EXPECT_LT(adaptive.beamRelL2, sameCells.beamRelL2) << photons << " photon paths";
+        // Also when the uniform cache gets the adaptive one's whole memory,
+        // the fixed cost of its five VDB index trees included.
+        EXPECT_LT(adaptive.relL2, sameBytes.relL2) << photons << " photon paths";
+        if (std::getenv("VDBMARCH_VERBOSE"))
+            std::printf("%lld paths | adaptive: %zu cells %zu KB, rel. L2 %.3f, edge %.3f, %d levels"
+                        " | uniform, same cells: %zu cells %zu KB, %.3f, edge %.3f"
+                        " | uniform, same bytes: %zu cells %zu KB, %.3f, edge %.3f\n",
+                        (long long)photons, adaptive.cells, adaptive.bytes / 1024, adaptive.relL2,
+                        adaptive.beamRelL2, r.cache.levels, sameCells.cells, sameCells.bytes / 1024, sameCells.relL2,
+                        sameCells.beamRelL2, sameBytes.cells, sameBytes.bytes / 1024, sameBytes.relL2,
+                        sameBytes.beamRelL2);
+    }
+}
+
 TEST(RadianceCacheFile, RoundTripKeepsEveryCellAndCoefficient) {
     for (bool adaptive : {false, true}) {
         auto scene = sceneFromJson(spotScene(0.7f, adaptive));
