@@ -16,6 +16,7 @@
 #include "image/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
+#include "image/png_io.h"
 #include "core/transform.h"
 #include "render.h"
 
@@ -91,7 +92,79 @@ std::string vdbRenderCommand(const SceneDesc& d, const Scene& scene, double step
                stepVoxels, " -compression none -cpus ", d.render.threads, " >/dev/null 2>&1");
 }
 
+// Source pixels and weights (summing to 1) of each output pixel along one axis
+// when `from` pixels are resampled to `to` by area averaging.
+struct Tap {
+    int index;
+    float weight;
+};
+std::vector<std::vector<Tap>> boxTaps(int from, int to) {
+    std::vector<std::vector<Tap>> taps(static_cast<size_t>(to));
+    const double scale = double(from) / double(to);
+    for (int o = 0; o < to; ++o) {
+        const double lo = o * scale, hi = (o + 1) * scale;
+        for (int i = int(std::floor(lo)); i < std::min(from, int(std::ceil(hi))); ++i) {
+            double w = std::min(hi, i + 1.0) - std::max(lo, double(i));
+            if (w > 0) taps[size_t(o)].push_back({i, float(w / (hi - lo))});
+        }
+    }
+    return taps;
+}
+
+// Index of the run with the median time (the upper one for an even count, as
+// the reported seconds).
+size_t medianRun(const std::vector<double>& times) {
+    std::vector<size_t> order(times.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return times[a] < times[b]; });
+    return order[order.size() / 2];
+}
+
+// tiles[row][column]; an empty Image leaves its cell in the separator colour.
+void writeStrip(const std::string& path, const std::vector<std::vector<Image>>& tiles, int columns,
+                bool referenceColumn, int tileW, int tileH, float exposure) {
+    auto columnX = [&](int c) {
+        int gapAfterReference = referenceColumn && c > 0 ? StripReferenceGap - StripSeparator : 0;
+        return c * (tileW + StripSeparator) + gapAfterReference;
+    };
+    const int width = columnX(columns - 1) + tileW;
+    const int height = int(tiles.size()) * (tileH + StripSeparator) - StripSeparator;
+    std::vector<uint8_t> rgb(size_t(width) * size_t(height) * 3, StripSeparatorValue);
+    for (size_t r = 0; r < tiles.size(); ++r)
+        for (size_t c = 0; c < tiles[r].size(); ++c) {
+            const Image& t = tiles[r][c];
+            if (t.empty()) continue;
+            std::vector<uint8_t> tile = toSrgb8(t, exposure);
+            const int x0 = columnX(int(c)), y0 = int(r) * (tileH + StripSeparator);
+            for (int y = 0; y < tileH; ++y)
+                std::copy_n(&tile[size_t(y) * size_t(tileW) * 3], size_t(tileW) * 3,
+                            &rgb[(size_t(y0 + y) * size_t(width) + size_t(x0)) * 3]);
+        }
+    writePngRgb8(path, width, height, rgb);
+}
+
 }  // namespace
+
+Image downscaleBox(const Image& img, int width, int height) {
+    if (width <= 0 || height <= 0 || img.empty())
+        throw InputError(str("cannot resample a ", img.width, "x", img.height, " image to ", width, "x", height));
+    // Separable: rows first (img.width -> width), then columns.
+    const auto tx = boxTaps(img.width, width), ty = boxTaps(img.height, height);
+    Image rows(width, img.height), out(width, height);
+    const size_t inRow = size_t(img.width) * 4, outRow = size_t(width) * 4;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < width; ++x)
+            for (const Tap& t : tx[size_t(x)])
+                for (size_t c = 0; c < 4; ++c) {
+                    float v = img.rgba[size_t(y) * inRow + size_t(t.index) * 4 + c];
+                    rows.rgba[size_t(y) * outRow + size_t(x) * 4 + c] += std::isfinite(v) ? t.weight * v : 0.f;
+                }
+    for (int y = 0; y < height; ++y)
+        for (const Tap& t : ty[size_t(y)])
+            for (size_t i = 0; i < outRow; ++i)
+                out.rgba[size_t(y) * outRow + i] += t.weight * rows.rgba[size_t(t.index) * outRow + i];
+    return out;
+}
 
 BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     if (o.methods.empty()) throw InputError("bench: --methods is empty");
@@ -101,8 +174,22 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     for (double b : o.budgets)
         if (!(b > 0) || (!o.budgetSeconds && b != std::floor(b)))
             throw InputError(str("bench: budget ", b, " must be a positive ", o.budgetSeconds ? "number of seconds" : "whole number of samples"));
+    // Strip columns: the longest budget list of the methods (vdb_render has its own).
+    int stripColumns = o.stripReference ? 1 : 0;
+    {
+        size_t most = 0;
+        for (const auto& m : o.methods)
+            most = std::max(most, (m == "vdb_render" ? o.vdbRenderSteps : o.budgets).size());
+        stripColumns += int(most);
+    }
+    const int stripGaps =
+        (stripColumns - 1) * StripSeparator + (o.stripReference ? StripReferenceGap - StripSeparator : 0);
+    if (!o.stripPath.empty() && o.stripMaxWidth < stripColumns + stripGaps)
+        throw InputError(str("bench: --strip-width ", o.stripMaxWidth, " is too small for ", stripColumns,
+                             " strip columns (at least ", stripColumns + stripGaps, " pixels)"));
     ::mkdir(o.outDir.c_str(), 0755);
     checkWritable(o.outDir + "/bench.csv");
+    if (!o.stripPath.empty()) checkWritable(o.stripPath);
     BenchResult result;
     // Loaded once: every render below only changes the render settings.
     std::unique_ptr<Scene> scene = buildScene(baseScene);
@@ -144,7 +231,32 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
         result.referenceImage = path;
     }
 
-    for (const auto& method : o.methods) {
+    // Tiles keep the image size unless the strip would exceed its width.
+    int tileW = reference.width, tileH = reference.height;
+    if (tileW * stripColumns + stripGaps > o.stripMaxWidth) {
+        tileW = std::max(1, (o.stripMaxWidth - stripGaps) / stripColumns);
+        tileH = std::max(1, int(std::lround(double(reference.height) * tileW / reference.width)));
+    }
+    // Downscaled as soon as rendered, so large benches do not hold every image.
+    auto makeTile = [&](const Image& img) {
+        return tileW == img.width && tileH == img.height ? img : downscaleBox(img, tileW, tileH);
+    };
+    std::vector<std::vector<Image>> tiles(o.methods.size());
+    if (!o.stripPath.empty() && o.stripReference) {
+        Image referenceTile = makeTile(reference);
+        for (auto& row : tiles) row.push_back(referenceTile);
+    }
+    auto measure = [&](BenchRow& row, const Image& img) {
+        RelErrorSpread sp = relativeErrorSpread(img, reference, BenchSpreadMinAlpha);
+        row.relP50 = sp.p50;
+        row.relP95 = sp.p95;
+        row.relSpread = sp.ratio;
+        result.spreadEps = sp.eps;
+        result.spreadPixels = sp.pixels;
+    };
+
+    for (size_t mi = 0; mi < o.methods.size(); ++mi) {
+        const std::string& method = o.methods[mi];
         for (double budget : method == "vdb_render" ? o.vdbRenderSteps : o.budgets) {
             if (method == "vdb_render") {
                 // Budget = step in voxels; time = the whole command (load + render + write).
@@ -157,37 +269,45 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
                         throw IoError(str("bench: vdb_render failed (is libopenvdb-tools installed?): ", cmd));
                     times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
                 }
-                std::sort(times.begin(), times.end());
-                ImageErrorStats e = compareImages(readExr(out), reference);
-                BenchRow row{method, budget, times[times.size() / 2], e.rmse, e.relMse, 1};
-                std::fprintf(stderr, "bench: %-10s step %-8g %9.3f s  rmse %.5g  relmse %.5g\n", method.c_str(), budget,
-                             row.seconds, row.rmse, row.relMse);
+                // vdb_render is deterministic: the last run's file is the median run's image.
+                Image img = readExr(out);
+                ImageErrorStats e = compareImages(img, reference);
+                BenchRow row{method, budget, times[medianRun(times)], e.rmse, e.relMse, 1};
+                measure(row, img);
+                if (!o.stripPath.empty()) tiles[mi].push_back(makeTile(img));
+                std::fprintf(stderr, "bench: %-10s step %-8g %9.3f s  rmse %.5g  relmse %.5g  rel p95/p50 %.4g\n",
+                             method.c_str(), budget, row.seconds, row.rmse, row.relMse, row.relSpread);
                 result.rows.push_back(row);
                 continue;
             }
             RenderOptions ro;
             if (o.budgetSeconds) ro.timeBudget = budget;
             const int spp = o.budgetSeconds ? baseScene.render.spp : int(budget);
+            // All runs are kept until the median-time one is known: with
+            // --seconds their sample counts, hence images, may differ.
             std::vector<double> times;
-            RenderResult last;
+            std::vector<RenderResult> runs;
             for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
-                last = renderWith(method, spp, baseScene.render.seed, ro);
-                times.push_back(last.seconds);
+                runs.push_back(renderWith(method, spp, baseScene.render.seed, ro));
+                times.push_back(runs.back().seconds);
             }
-            std::sort(times.begin(), times.end());
-            ImageErrorStats e = compareImages(last.image, reference);
-            BenchRow row{method, budget, times[times.size() / 2], e.rmse, e.relMse, last.spp};
-            std::fprintf(stderr, "bench: %-10s budget %-8g %4d spp %9.3f s  rmse %.5g  relmse %.5g\n", method.c_str(),
-                         budget, row.spp, row.seconds, row.rmse, row.relMse);
+            const RenderResult& med = runs[medianRun(times)];
+            ImageErrorStats e = compareImages(med.image, reference);
+            BenchRow row{method, budget, med.seconds, e.rmse, e.relMse, med.spp};
+            measure(row, med.image);
+            if (!o.stripPath.empty()) tiles[mi].push_back(makeTile(med.image));
+            std::fprintf(stderr, "bench: %-10s budget %-8g %4d spp %9.3f s  rmse %.5g  relmse %.5g  rel p95/p50 %.4g\n",
+                         method.c_str(), budget, row.spp, row.seconds, row.rmse, row.relMse, row.relSpread);
             result.rows.push_back(row);
         }
     }
 
     // CSV
     std::ostringstream csv;
-    csv << "method,budget,spp,seconds,rmse,relmse\n";
+    csv << "method,budget,spp,seconds,rmse,relmse,rel_p50,rel_p95,rel_p95_over_p50\n";
     for (const auto& r : result.rows)
-        csv << r.method << "," << r.budget << "," << r.spp << "," << r.seconds << "," << r.rmse << "," << r.relMse << "\n";
+        csv << r.method << "," << r.budget << "," << r.spp << "," << r.seconds << "," << r.rmse << "," << r.relMse
+            << "," << r.relP50 << "," << r.relP95 << "," << r.relSpread << "\n";
     result.csvPath = o.outDir + "/bench.csv";
     writeTextFileAtomic(result.csvPath, csv.str());
 
@@ -197,10 +317,16 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     std::ostringstream md;
     md << "# vdbmarch bench\n\nReference image: `" << result.referenceImage << "`";
     if (result.referenceNoiseRmse > 0) md << " (its own estimated noise: RMSE " << result.referenceNoiseRmse << ")";
-    md << "\n\n| method | budget | spp | seconds | RMSE | relMSE |\n|---|---|---|---|---|---|\n";
+    md << "\n\n| method | budget | spp | seconds | RMSE | relMSE | rel. error p50 | rel. error p95 | p95/p50 |\n"
+          "|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : result.rows)
         md << "| " << r.method << " | " << r.budget << " | " << r.spp << " | " << r.seconds << " | " << r.rmse << " | "
-           << r.relMse << " |\n";
+           << r.relMse << " | " << r.relP50 << " | " << r.relP95 << " | " << r.relSpread << " |\n";
+    md << "\nPer-pixel relative error e = mean over RGB of |I - R| / (R + eps), eps = " << RelSpreadEpsilonFraction
+       << " x the reference mean = " << result.spreadEps << ", over the " << result.spreadPixels
+       << " pixels where the reference's alpha >= " << BenchSpreadMinAlpha
+       << " (medium or surface in view); p50 and p95 are its nearest-rank percentiles. p95/p50 measures how unevenly "
+          "the error is spread over the image: lower is more homogeneous.\n";
     double logSum = 0;
     int count = 0;
     for (const auto& r : result.rows)
@@ -240,6 +366,19 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
             md << " " << ei / fits[j].at(tMid) << " | " << tMid / fits[j].timeFor(ei) << " |";
         }
         md << "\n";
+    }
+    if (!o.stripPath.empty()) {
+        writeStrip(o.stripPath, tiles, stripColumns, o.stripReference, tileW, tileH, baseScene.render.exposure);
+        result.stripPath = o.stripPath;
+        result.stripRows = int(tiles.size());
+        result.stripColumns = stripColumns;
+        result.tileWidth = tileW;
+        result.tileHeight = tileH;
+        std::string names;
+        for (const auto& m : o.methods) names += (names.empty() ? "" : ", ") + m;
+        md << "\nImage strip: `" << o.stripPath << "` (rows: " << names << "; columns: "
+           << (o.stripReference ? "the reference, then " : "") << "the budgets in order; " << tileW << "x" << tileH
+           << " tiles, exposure " << baseScene.render.exposure << " stops)\n";
     }
     result.tablePath = o.outDir + "/bench.md";
     writeTextFileAtomic(result.tablePath, md.str());

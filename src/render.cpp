@@ -55,7 +55,6 @@ private:
 
 RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const RenderSettings& rs = scene.desc.render;
-    std::unique_ptr<Marcher> marcher = makeMarcher(rs.method, scene);
     const int w = scene.camera->width(), h = scene.camera->height();
     const int tilesX = (w + TileSize - 1) / TileSize, tilesY = (h + TileSize - 1) / TileSize;
     const int tiles = tilesX * tilesY;
@@ -71,6 +70,18 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     auto start = std::chrono::steady_clock::now();
     auto runStart = options.runStart ? *options.runStart : start;
     tbb::task_arena arena(threads);
+
+    // Photons and the cache count in the time budget: an equal-time
+    // comparison charges the guided marcher for its cache.
+    std::shared_ptr<Illumination> illumination;
+    arena.execute([&] {
+        illumination = std::make_shared<Illumination>(prepareIllumination(scene, rs.method, options.illumination));
+    });
+    result.illuminationSeconds = illumination->seconds;
+    result.photons = illumination->photons;
+    result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
+    std::unique_ptr<Marcher> marcher;
+    arena.execute([&] { marcher = makeMarcher(rs.method, scene, illumination); });
 
     // One pass renders samples [s0, s1) of every pixel. Each pixel sums its
     // samples in index order, so the image depends only on the final sample

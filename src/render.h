@@ -1,4 +1,4 @@
-// The pipeline: scene -> (photons -> cache, later) -> marcher -> image.
+// The pipeline: scene -> photons -> cache -> marcher -> image.
 #pragma once
 
 #include <chrono>
@@ -8,6 +8,7 @@
 
 #include "core/stats.h"
 #include "image/image.h"
+#include "marchers/illumination.h"
 #include "scene/scene.h"
 
 namespace vdbmarch {
@@ -19,12 +20,15 @@ struct RenderOptions {
     // instead of render.spp samples.
     double timeBudget = 0;
     std::optional<std::chrono::steady_clock::time_point> runStart;
+    IlluminationOptions illumination;  // a baked cache to load (render --cache)
 };
 
 struct RenderResult {
     Image image;
     RenderCounters counters;
-    double seconds = 0;   // rendering only
+    double seconds = 0;   // photons, cache and rendering
+    double illuminationSeconds = 0;  // photon tracing and cache (part of seconds)
+    size_t photons = 0, cacheCells = 0;
     int threads = 0;      // worker threads used
     int spp = 0;          // samples per pixel actually rendered
 };

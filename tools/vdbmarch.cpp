@@ -138,7 +138,8 @@ int runRender(const RenderArgs& a) {
         s["step"] = scene->step;
         s["shadow_step"] = scene->shadowStep;
         s["counters"] = {{"camera_rays", c.cameraRays},         {"surface_hits", c.surfaceHits},
-                         {"march_samples", c.marchSamples},     {"shadow_rays", c.shadowRays},
+                         {"march_samples", c.marchSamples},     {"li_samples", c.liSamples},
+                         {"shadow_rays", c.shadowRays},
                          {"shadow_samples", c.shadowSamples},   {"non_finite_samples", c.nonFiniteSamples},
                          {"marched_length", c.marchedLength},   {"skipped_empty_length", c.skippedLength}};
         writeTextFileAtomic(a.stats, s.dump(2) + "\n");
@@ -164,8 +165,9 @@ int runCompare(const std::string& a, const std::string& b, const std::string& di
 
 struct BenchArgs {
     std::string scene, methods = "uniform,reference", budgets = "1,2,4,8", vdbSteps = "4,2,1,0.5", out, reference, res;
-    bool seconds = false;
-    int referenceSpp = 256, repeats = 1;
+    std::string strip;
+    bool seconds = false, stripNoReference = false;
+    int referenceSpp = 256, repeats = 1, stripWidth = 2000;
     std::vector<std::string> sets;
 };
 
@@ -203,6 +205,12 @@ int runBenchCommand(const BenchArgs& a) {
     }
     if (a.referenceSpp < 2) throw InputError(str("--reference-spp ", a.referenceSpp, ": must be at least 2"));
     if (a.repeats < 1) throw InputError(str("--repeats ", a.repeats, ": must be at least 1"));
+    if (!a.strip.empty() && !endsWith(a.strip, ".png"))
+        throw InputError(str("--strip ", a.strip, ": the strip must be a .png file"));
+    if (a.stripWidth < 1) throw InputError(str("--strip-width ", a.stripWidth, ": must be a positive number of pixels"));
+    o.stripPath = a.strip;
+    o.stripReference = !a.stripNoReference;
+    o.stripMaxWidth = a.stripWidth;
     o.budgetSeconds = a.seconds;
     o.outDir = a.out;
     o.referencePath = a.reference;
@@ -211,8 +219,8 @@ int runBenchCommand(const BenchArgs& a) {
     BenchResult r = runBench(desc, o);
     std::printf("reference: %s", r.referenceImage.c_str());
     if (r.referenceNoiseRmse > 0) std::printf(" (estimated noise RMSE %.5g)", r.referenceNoiseRmse);
-    std::printf("\nwrote %s, %s%s%s\n", r.csvPath.c_str(), r.tablePath.c_str(), r.plotPath.empty() ? "" : ", ",
-                r.plotPath.c_str());
+    std::printf("\nwrote %s, %s%s%s%s%s\n", r.csvPath.c_str(), r.tablePath.c_str(), r.plotPath.empty() ? "" : ", ",
+                r.plotPath.c_str(), r.stripPath.empty() ? "" : ", ", r.stripPath.c_str());
     return 0;
 }
 
@@ -377,7 +385,11 @@ int main(int argc, char** argv) {
     BenchArgs ba;
     CLI::App* bench = app.add_subcommand("bench", "Run time against error: methods x budgets against a reference");
     bench->add_option("scene", ba.scene, "Scene .json or .vdb")->required();
-    bench->add_option("-o,--output", ba.out, "Output folder (bench.csv, bench.md, bench.png, cached reference)")->required();
+    bench->add_option("-o,--output", ba.out,
+                      "Output folder: bench.csv and bench.md (seconds, RMSE, relMSE, and the 50th and 95th "
+                      "percentiles and p95/p50 of the per-pixel relative error |I-R|/(R+eps), eps = 1% of the "
+                      "reference mean, where the reference's alpha >= 0.01: lower p95/p50 = more even quality), "
+                      "bench.png, the cached reference")->required();
     bench->add_option("--methods", ba.methods, "Comma-separated methods (default uniform,reference)");
     bench->add_option("--budgets", ba.budgets, "Comma-separated budgets: spp, or seconds with --seconds");
     bench->add_option("--vdb-render-steps", ba.vdbSteps,
@@ -388,6 +400,12 @@ int main(int argc, char** argv) {
     bench->add_option("--repeats", ba.repeats, "Runs per point; the median time is kept (default 1)");
     bench->add_option("--res", ba.res, "Resolution WIDTHxHEIGHT");
     bench->add_option("--set", ba.sets, "Override a scene key: key.path=value, repeatable");
+    bench->add_option("--strip", ba.strip,
+                      "Also write a PNG image strip: a row per method, a column per budget (the median-time run), "
+                      "the reference first; tone mapped as the --png preview with render.exposure");
+    bench->add_flag("--strip-no-reference", ba.stripNoReference, "Leave the reference column out of the strip");
+    bench->add_option("--strip-width", ba.stripWidth,
+                      "Largest strip width in pixels; tiles are box-downscaled to fit (default 2000)");
 
     BakeArgs ka;
     CLI::App* bake = app.add_subcommand("bake", "Trace photons and bake the in-scattered radiance cache to a .vdb");

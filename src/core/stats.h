@@ -10,6 +10,7 @@ struct RenderCounters {
     uint64_t cameraRays = 0;        // camera paths started (pixels x spp)
     uint64_t surfaceHits = 0;       // surface interactions along camera paths
     uint64_t marchSamples = 0;      // medium samples along camera rays
+    uint64_t liSamples = 0;         // points where L_i was estimated
     uint64_t shadowRays = 0;        // shadow rays traced
     uint64_t shadowSamples = 0;     // medium samples along shadow rays
     uint64_t nonFiniteSamples = 0;  // NaN/Inf path results dropped
@@ -20,6 +21,7 @@ struct RenderCounters {
         cameraRays += o.cameraRays;
         surfaceHits += o.surfaceHits;
         marchSamples += o.marchSamples;
+        liSamples += o.liSamples;
         shadowRays += o.shadowRays;
         shadowSamples += o.shadowSamples;
         nonFiniteSamples += o.nonFiniteSamples;

@@ -75,6 +75,50 @@ ImageErrorStats compareImages(const Image& test, const Image& reference) {
     return s;
 }
 
+RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, float minReferenceAlpha) {
+    checkSameSize(test, reference);
+    const size_t count = test.pixelCount();
+    std::vector<size_t> use;
+    use.reserve(count);
+    for (int pass = 0; pass < 2 && use.empty(); ++pass)
+        for (size_t i = 0; i < count; ++i)
+            if (finiteRgb(test, i) && finiteRgb(reference, i) &&
+                (pass == 1 || reference.rgba[i * 4 + 3] >= minReferenceAlpha))
+                use.push_back(i);
+    RelErrorSpread s;
+    s.pixels = use.size();
+    if (use.empty()) {
+        s.p50 = s.p95 = s.ratio = s.eps = std::numeric_limits<double>::quiet_NaN();
+        return s;
+    }
+    double mean = 0;
+    for (size_t i : use)
+        for (int c = 0; c < 3; ++c) mean += reference.rgba[i * 4 + c];
+    mean /= 3.0 * double(use.size());
+    // A fraction of the mean rather than an absolute constant, so the figure
+    // does not depend on the scene's brightness or exposure.
+    s.eps = mean > 0 ? RelSpreadEpsilonFraction * mean : RelEpsilon;
+    std::vector<double> err;
+    err.reserve(use.size());
+    for (size_t i : use) {
+        double e = 0;
+        for (int c = 0; c < 3; ++c) {
+            double a = test.rgba[i * 4 + c], b = reference.rgba[i * 4 + c];
+            e += std::abs(a - b) / (std::abs(b) + s.eps);
+        }
+        err.push_back(e / 3.0);
+    }
+    auto percentile = [&](double p) {
+        size_t rank = size_t(std::max(1.0, std::ceil(p * double(err.size())))) - 1;
+        std::nth_element(err.begin(), err.begin() + rank, err.end());
+        return err[rank];
+    };
+    s.p50 = percentile(0.50);
+    s.p95 = percentile(0.95);
+    s.ratio = s.p95 == 0 ? 0.0 : s.p50 == 0 ? std::numeric_limits<double>::infinity() : s.p95 / s.p50;
+    return s;
+}
+
 void writeFalseColorDiff(const std::string& path, const Image& test, const Image& reference) {
     checkSameSize(test, reference);
     const size_t count = test.pixelCount();

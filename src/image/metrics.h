@@ -24,6 +24,24 @@ struct ImageErrorStats {
 // Throws InputError if the sizes differ.
 ImageErrorStats compareImages(const Image& test, const Image& reference);
 
+// How evenly the error is spread over the image (the paper's "almost
+// homogeneous image quality"): per pixel, the relative error
+// e = mean over RGB of |a-b| / (|b| + eps), eps = RelSpreadEpsilonFraction x
+// the reference's mean RGB value over the compared pixels (1e-2 absolute when
+// that mean is not positive), then nearest-rank percentiles of e (the value at
+// sorted index ceil(p n) - 1). Compared pixels: finite in both images, with
+// reference alpha >= minReferenceAlpha; all finite pixels when none qualifies.
+struct RelErrorSpread {
+    double p50 = 0, p95 = 0;
+    double ratio = 0;    // p95 / p50; 0 when p95 = 0 (no error at all), inf when only p50 = 0
+    double eps = 0;      // the epsilon used
+    size_t pixels = 0;   // pixels compared
+};
+constexpr double RelSpreadEpsilonFraction = 1e-2;
+
+// Throws InputError if the sizes differ. With no pixel to compare, all NaN.
+RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, float minReferenceAlpha = 0.f);
+
 // PNG of the per-pixel error |a-b| averaged over RGB, divided by its 99th
 // percentile (so a few fireflies do not wash out the rest) and mapped through
 // the viridis ramp: dark purple = no error, yellow = at or above the 99th

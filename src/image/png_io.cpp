@@ -59,6 +59,10 @@ void writePng(const std::string& path, const Image& img, float exposureStops) {
     if (img.rgba.size() != img.pixelCount() * 4)
         throw InputError(str("cannot write '", path, "': pixel buffer does not match ", img.width,
                              "x", img.height));
+    writePngRgb8(path, img.width, img.height, toSrgb8(img, exposureStops));
+}
+
+std::vector<uint8_t> toSrgb8(const Image& img, float exposureStops) {
     const float scale = std::exp2(exposureStops);
     std::vector<uint8_t> rgb(img.pixelCount() * 3);
     for (size_t i = 0; i < img.pixelCount(); ++i) {
@@ -69,7 +73,7 @@ void writePng(const std::string& path, const Image& img, float exposureStops) {
             rgb[i * 3 + c] = uint8_t(std::lround(v * 255.f));
         }
     }
-    writePngRgb8(path, img.width, img.height, rgb);
+    return rgb;
 }
 
 Image readPng(const std::string& path) {

@@ -18,6 +18,10 @@ float srgbToLinear(float v);
 // atomically. Throws InputError for an empty image, IoError on write failure.
 void writePng(const std::string& path, const Image& img, float exposureStops = 0);
 
+// writePng's tone mapping alone: 3 bytes per pixel, top row first, so other
+// layouts (the bench's image strip) show pixels exactly as the PNG preview does.
+std::vector<uint8_t> toSrgb8(const Image& img, float exposureStops = 0);
+
 // Writes already display-encoded 8-bit RGB (3 bytes per pixel, top row first).
 void writePngRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 

@@ -10,7 +10,9 @@
 
 #include "core/math.h"
 #include "core/rng.h"
+#include "cache/cache_lookup.h"
 #include "core/stats.h"
+#include "marchers/ray_pdf.h"
 #include "scene/scene.h"
 
 namespace vdbmarch {
@@ -24,6 +26,16 @@ struct ThreadContext {
     std::vector<Interval> intervals, shadowIntervals, scratch;
     std::vector<MajorantSegment> majorants, scratchSegments;
     RenderCounters counters;
+    // The sampled marchers' per-ray histogram: steps, their media, the cache.
+    std::vector<PdfStep> pdfSteps;
+    std::vector<Color> stepSigmaS, stepKappa, stepT;
+    std::vector<float> stepH;
+    RayPdf rayPdf;
+    std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
+    // The guided marcher's pre-pass (eq. 17's scale): march without sampling
+    // and sum each segment's throughput times its histogram integral.
+    bool measureOnly = false;
+    double measuredGuided = 0;
 };
 
 // Coefficients of all media of a region at one point. Each medium's

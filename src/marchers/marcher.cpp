@@ -1,17 +1,20 @@
 #include "marchers/marcher.h"
 
 #include "core/error.h"
+#include "marchers/illumination.h"
 
 namespace vdbmarch {
 
 namespace {
 struct Entry {
     const char* name;
-    std::unique_ptr<Marcher> (*make)(const Scene&);
+    std::unique_ptr<Marcher> (*make)(const Scene&, std::shared_ptr<const Illumination>);
 };
 // The factory table: one line per method.
 const Entry kMarchers[] = {
     {"uniform", makeUniformMarcher},
+    {"transmittance", makeTransmittanceMarcher},
+    {"guided", makeGuidedMarcher},
     {"reference", makeReferenceTracer},
 };
 }  // namespace
@@ -22,9 +25,13 @@ std::vector<std::string> marcherNames() {
     return names;
 }
 
-std::unique_ptr<Marcher> makeMarcher(const std::string& method, const Scene& scene) {
+std::unique_ptr<Marcher> makeMarcher(const std::string& method, const Scene& scene,
+                                     std::shared_ptr<const Illumination> illumination) {
     for (const auto& e : kMarchers)
-        if (method == e.name) return e.make(scene);
+        if (method == e.name) {
+            if (!illumination) illumination = std::make_shared<Illumination>(prepareIllumination(scene, method));
+            return e.make(scene, std::move(illumination));
+        }
     std::string known;
     for (const auto& e : kMarchers) known += str(" ", e.name);
     throw InputError(str("unknown method \"", method, "\"; this build implements:", known));

@@ -13,6 +13,7 @@
 namespace vdbmarch {
 
 class Scene;
+struct Illumination;
 
 struct PathResult {
     Color L;              // radiance towards the camera
@@ -27,11 +28,16 @@ public:
 
 // Methods this build implements, in the order `--method` lists them.
 std::vector<std::string> marcherNames();
-// Throws InputError for an unknown name, listing the known ones.
-std::unique_ptr<Marcher> makeMarcher(const std::string& method, const Scene& scene);
+// Throws InputError for an unknown name, listing the known ones. The
+// marchers estimate L_i from `illumination` (photon map, cache); when null it
+// is prepared here from the scene (prepareIllumination).
+std::unique_ptr<Marcher> makeMarcher(const std::string& method, const Scene& scene,
+                                     std::shared_ptr<const Illumination> illumination = nullptr);
 
 // Constructors behind the factory table.
-std::unique_ptr<Marcher> makeUniformMarcher(const Scene& scene);
-std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene);
+std::unique_ptr<Marcher> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
+std::unique_ptr<Marcher> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
+std::unique_ptr<Marcher> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
+std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il);
 
 }  // namespace vdbmarch

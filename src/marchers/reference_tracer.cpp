@@ -285,6 +285,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene) { return std::make_unique<ReferenceTracer>(scene); }
+std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination>) {
+    return std::make_unique<ReferenceTracer>(scene);
+}
 
 }  // namespace vdbmarch

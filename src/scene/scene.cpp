@@ -55,9 +55,6 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
                                 "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
                                 "light in the reference; use sphere lights where the reference must converge"));
     }
-    if (desc.render.maxDepth > 1 && desc.render.method == "uniform")
-        warn(str(desc.file, ": render.max_depth = ", desc.render.maxDepth,
-                 ": the uniform marcher computes single scattering (direct light) only in this release"));
 
     // Surfaces.
     scene->surfaceSet = std::make_unique<SurfaceSet>();

@@ -73,6 +73,11 @@ struct RenderSettings {
     bool pixelJitter = true;  // false: one ray through each pixel centre
     float exposure = 0;       // PNG preview, stops
     bool globalMajorant = false;  // reference: one majorant per grid (benchmarks only)
+    // How the marchers estimate L_i at their samples: "photons" (shadow rays
+    // for direct light plus the photon map's non-direct photons) or "cache"
+    // (the radiance cache alone: a fast, biased preview).
+    std::string li = "photons";
+    int raySamples = 4;  // transmittance and guided: L_i samples per ray segment (mean for guided)
 };
 
 // The volume photon map (scene key "photons").

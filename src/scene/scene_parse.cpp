@@ -259,7 +259,7 @@ SurfaceDesc parseSurface(const JsonReader& r) {
 
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
-                 "pixel_jitter", "exposure", "majorant"});
+                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples"});
     RenderSettings s;
     s.method = r.choice("method", s.method, marcherNames());  // the factory table is the one list
     s.spp = r.integer("spp", s.spp, 1, 1 << 24);
@@ -277,6 +277,8 @@ RenderSettings parseRender(const JsonReader& r) {
     s.pixelJitter = r.boolean("pixel_jitter", s.pixelJitter);
     s.exposure = float(r.numberIn("exposure", 0, -64, 64));
     s.globalMajorant = r.choice("majorant", "local", {"local", "global"}) == "global";
+    s.li = r.choice("li", s.li, {"photons", "cache"});
+    s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
     return s;
 }
 

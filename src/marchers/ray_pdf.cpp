@@ -1,0 +1,67 @@
+#include "marchers/ray_pdf.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vdbmarch {
+
+namespace {
+// Below this optical thickness a step's exponential is uniform to float precision.
+constexpr double ThinStep = 1e-5;
+}  // namespace
+
+double truncatedExponentialPdf(float kappa, float len, float x) {
+    const double tau = double(kappa) * double(len);
+    if (tau < ThinStep) return 1.0 / double(len);
+    return double(kappa) * std::exp(-double(kappa) * double(x)) / -std::expm1(-tau);
+}
+
+float sampleTruncatedExponential(float kappa, float len, double v) {
+    const double tau = double(kappa) * double(len);
+    double x = tau < ThinStep ? v * double(len) : -std::log1p(v * std::expm1(-tau)) / double(kappa);
+    // Rounding must not push the sample out of its step.
+    return float(std::min(std::max(x, 0.0), std::nextafter(double(len), 0.0)));
+}
+
+void RayPdf::build(const std::vector<PdfStep>& steps, const float* h, float defensive) {
+    mSteps = &steps;
+    mBase = mGuided = 0;
+    for (size_t k = 0; k < steps.size(); ++k) {
+        mBase += double(steps[k].base);
+        if (h) mGuided += double(steps[k].base) * double(h[k]);
+    }
+    mCdf.assign(steps.size() + 1, 0.0);
+    if (!(mBase > 0)) return;
+    // Mixture weights: a guided share only when the histogram has any light.
+    const double eps = h && mGuided > 0 ? double(defensive) : 1.0;
+    double c = 0;
+    for (size_t k = 0; k < steps.size(); ++k) {
+        double p = eps * double(steps[k].base) / mBase;
+        if (eps < 1) p += (1 - eps) * double(steps[k].base) * double(h[k]) / mGuided;
+        c += p;
+        mCdf[k + 1] = c;
+    }
+    for (size_t k = 1; k <= steps.size(); ++k) mCdf[k] /= c;  // exact 1 at the end despite rounding
+    mCdf.back() = 1.0;
+}
+
+void RayPdf::sample(double u, int& step, float& offset, double& pdf) const {
+    // The bin with cdf[k] <= u < cdf[k + 1]: it has positive width, so a
+    // bin of probability 0 is never chosen.
+    u = std::min(std::max(u, 0.0), std::nextafter(1.0, 0.0));
+    size_t k = size_t(std::upper_bound(mCdf.begin(), mCdf.end(), u) - mCdf.begin()) - 1;
+    const PdfStep& s = (*mSteps)[k];
+    const double pk = mCdf[k + 1] - mCdf[k];
+    const double v = std::min(std::max((u - mCdf[k]) / pk, 0.0), 1.0);
+    const float x = sampleTruncatedExponential(s.kappa, s.len, v);
+    step = int(k);
+    offset = x;
+    pdf = pk * truncatedExponentialPdf(s.kappa, s.len, x);
+}
+
+double RayPdf::pdf(int step, float offset) const {
+    const PdfStep& s = (*mSteps)[size_t(step)];
+    return stepProbability(step) * truncatedExponentialPdf(s.kappa, s.len, offset);
+}
+
+}  // namespace vdbmarch

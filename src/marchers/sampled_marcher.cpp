@@ -1,0 +1,176 @@
+// Baseline (ii), transmittance sampling (eqs. 6-11), and the paper's guided
+// marcher (eqs. 16-18). Both walk a camera-ray segment once in steps of the
+// scene's step, as the uniform marcher does, but only to build the per-ray
+// histogram: per step the media (one density lookup), the transmittance
+// T(t0) and, for guided, the cached L_i of the cell holding it (Y_lm of the
+// ray's direction evaluated once per ray, one tree lookup per cell crossed).
+// L_i, the expensive part (shadow rays and photon lookups), is then
+// estimated at only a few positions drawn from the pdf (ray_pdf.h):
+//
+//   transmittance:  P(t) ~ sigma_s T(t)            (eq. 9 with sigma_s)
+//   guided:         P(t) ~ h(t) sigma_s T(t), mixed with the above  (eq. 16)
+//
+// and weighted by the estimator of eq. 18,
+//
+//   Delta L = (1/N) sum_j T(t_j) sigma_s(t_j) L_i(t_j) / P(t_j),
+//
+// where T and sigma_s are the step's (the medium is constant per step, as in
+// eq. 5), so the pdf is only a pdf: for any histogram the expectation is
+// the same integral the uniform marcher approximates, without its one-
+// sample-per-step cost. VDB media are heterogeneous, so unlike the paper's
+// homogeneous segment the true transmittance is accumulated step by step
+// (the per-step exponential in between), which the pdf shares.
+//
+// Guided allots N per segment by eq. 17: proportional to the segment's
+// expected in-scattering sum(h sigma_s T S) times the path throughput,
+// relative to its mean over the image (a pre-pass of camera rays), between
+// render.ray_samples / 4 and 8 render.ray_samples; transmittance always takes
+// render.ray_samples. Emission is integrated on the steps, as uniform does.
+#include <algorithm>
+#include <cmath>
+
+#include "marchers/segment_marcher.h"
+
+namespace vdbmarch {
+
+namespace {
+
+constexpr int MinSamplesDivisor = 4;  // guided: at least ray_samples / 4 per segment (and 1)
+constexpr int MaxSamplesFactor = 8;   // guided: at most 8 ray_samples per segment
+constexpr int PrepassWidth = 32, PrepassHeight = 24;
+
+class SampledMarcher final : public SegmentMarcher {
+public:
+    SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il, bool guided)
+        : SegmentMarcher(scene, std::move(il)), mGuided(guided && mIllumination->cache) {
+        if (mGuided) mMeanGuided = measureMeanGuided();
+    }
+
+private:
+    // Eq. 17's scale: the mean over a grid of pixel-centre camera rays of
+    // their histogram integrals. Deterministic (fixed ray seeds).
+    double measureMeanGuided() const {
+        ThreadContext ctx(mScene);
+        ctx.measureOnly = true;
+        const int w = mScene.camera->width(), h = mScene.camera->height();
+        for (int j = 0; j < PrepassHeight; ++j)
+            for (int i = 0; i < PrepassWidth; ++i) {
+                Rng rng(hashValues(0x707265706173, uint64_t(j * PrepassWidth + i)));
+                float x = (float(i) + 0.5f) * float(w) / PrepassWidth, y = (float(j) + 0.5f) * float(h) / PrepassHeight;
+                radiance(mScene.camera->generateRay(x, y), rng, ctx);
+            }
+        return ctx.measuredGuided / (PrepassWidth * PrepassHeight);
+    }
+
+    int sampleCount(const RayPdf& pdf, const Color& beta) const {
+        const int M = mScene.desc.render.raySamples;
+        if (!mGuided || !(mMeanGuided > 0)) return M;
+        double share = double(average(beta)) * pdf.guidedIntegral() / mMeanGuided;
+        double n = std::round(double(M) * share);
+        return int(std::clamp(n, double(std::max(1, M / MinSamplesDivisor)), double(MaxSamplesFactor * M)));
+    }
+
+    bool marchSegment(ThreadContext& ctx, int region, const Ray& ray, float tEnd, Rng& rng, Color& L,
+                      Color& beta) const override {
+        const Scene& scene = mScene;
+        bool infiniteTail;
+        if (!activeIntervals(ctx, region, ray, tEnd, infiniteTail)) return true;
+        auto& steps = ctx.pdfSteps;
+        steps.clear();
+        ctx.stepSigmaS.clear();
+        ctx.stepKappa.clear();
+        ctx.stepT.clear();
+        ctx.stepH.clear();
+        CacheLookup* cache = mGuided ? &cacheLookup(ctx) : nullptr;
+        if (cache) cache->setDirection(-ray.d);
+
+        // The walk: steps [k dx, (k + 1) dx) clipped to the active
+        // intervals, the medium taken at one jittered point per step.
+        const double dx = double(scene.step);
+        const double u = double(rng.uniform());
+        Color T(1);  // from the segment's start
+        bool ended = false;
+        MediumPoint mp;
+        for (const Interval& iv : ctx.intervals) {
+            for (double k = std::floor(double(iv.t0) / dx); !ended; k += 1) {
+                const double a = std::max(double(iv.t0), k * dx), b = std::min(double(iv.t1), (k + 1) * dx);
+                if (a >= double(iv.t1)) break;
+                if (!(b > a)) continue;
+                const Vec3 x = ray.at(float(a + u * (b - a)));
+                evalMedia(ctx, region, x, mp);
+                ++ctx.counters.marchSamples;
+                if (isBlack(mp.sigma_t)) continue;
+                const float len = float(b - a);
+                const StepTerms st = stepTerms(mp, len);
+                L += beta * T * st.absorbedA * mp.emission;
+                const float base = average(T * st.absorbedS);  // sigma_s T(t0) S(kappa, len)
+                if (mp.count > 0 && base > 0) {
+                    steps.push_back({float(a), len, average(mp.sigma_t), base});
+                    ctx.stepSigmaS.push_back(mp.sigma_s);
+                    ctx.stepKappa.push_back(mp.sigma_t);
+                    ctx.stepT.push_back(T);
+                    if (cache) ctx.stepH.push_back(cache->at(x));
+                }
+                T *= st.T;
+                const float m = maxComponent(beta * T);
+                if (m < RouletteThreshold) {
+                    // Russian roulette on the rest of the segment; the steps
+                    // already taken keep their weights, later ones carry 1/q.
+                    const float q = m / RouletteThreshold;
+                    if (rng.uniform() >= q) {
+                        T = Color(0);
+                        ended = true;
+                    } else {
+                        T /= q;
+                    }
+                }
+            }
+            if (ended) break;
+        }
+
+        if (!steps.empty()) {
+            RayPdf& pdf = ctx.rayPdf;
+            pdf.build(steps, cache ? ctx.stepH.data() : nullptr);
+            if (ctx.measureOnly) {
+                ctx.measuredGuided += double(average(beta)) * pdf.guidedIntegral();
+            } else if (pdf.valid()) {
+                // N stratified positions (one uniform per stratum of the CDF).
+                const int n = sampleCount(pdf, beta);
+                MediumPoint ms;
+                for (int j = 0; j < n; ++j) {
+                    int k;
+                    float offset;
+                    double p;
+                    pdf.sample((double(j) + double(rng.uniform())) / double(n), k, offset, p);
+                    const PdfStep& s = steps[size_t(k)];
+                    const Vec3 x = ray.at(s.t0 + offset);
+                    evalMedia(ctx, region, x, ms);  // the phase mixture at x
+                    const Color Li = inScattered(ctx, region, x, ray.d, ms, rng);
+                    if (isBlack(Li)) continue;
+                    Color Tt = ctx.stepT[size_t(k)];
+                    for (int c = 0; c < 3; ++c) Tt[c] *= std::exp(-ctx.stepKappa[size_t(k)][c] * offset);
+                    L += beta * Tt * ctx.stepSigmaS[size_t(k)] * Li * float(1.0 / (double(n) * p));
+                }
+            }
+        }
+        beta *= T;
+        if (ended) return false;
+        if (infiniteTail) applyInfiniteTail(region, beta);
+        return true;
+    }
+
+    const bool mGuided;
+    double mMeanGuided = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Marcher> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
+    return std::make_unique<SampledMarcher>(scene, std::move(il), false);
+}
+
+std::unique_ptr<Marcher> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
+    return std::make_unique<SampledMarcher>(scene, std::move(il), true);
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,154 @@
+#include "marchers/segment_marcher.h"
+
+#include <cmath>
+
+#include "core/error.h"
+#include "core/sampling.h"
+
+namespace vdbmarch {
+
+SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination)
+    : mScene(scene), mIllumination(std::move(illumination)) {
+    if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
+}
+
+PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
+    const Scene& scene = mScene;
+    ++ctx.counters.cameraRays;
+    Color L(0), beta(1);
+    Ray ray = cameraRay;
+    int region = regionAtRayStart(scene, ray);
+    for (int bounce = 0;; ++bounce) {
+        SurfaceHit h;
+        bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
+        float tLight = Infinity;
+        int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
+        float segEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+        if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f};
+        if (light >= 0) {
+            L += beta * scene.lights[size_t(light)].emittedRadiance();
+            return {L, 0.f};
+        }
+        if (!hit) {
+            L += beta * scene.background;
+            return {L, average(beta)};
+        }
+        ++ctx.counters.surfaceHits;
+        if (bounce >= scene.desc.render.maxSurfaceBounces) return {L, 0.f};
+        const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+        bool entering = dot(ray.d, h.n) < 0;
+        switch (s.material.type) {
+            case MaterialDesc::Type::Diffuse:
+                L += beta * directDiffuse(ctx, region, h.p, h.n, ray.d, s.material.albedo, rng);
+                return {L, 0.f};
+            case MaterialDesc::Type::Interface:
+                region = entering ? s.interiorRegion : s.exteriorRegion;
+                ray.o = offsetRayOrigin(scene, h.p, h.n, ray.d);
+                break;
+            case MaterialDesc::Type::Dielectric: {
+                // Smooth Fresnel: reflect with probability F, else refract;
+                // the weights F/F and (1-F)/(1-F) cancel. The shading
+                // normal bends the directions; the geometric normal decides
+                // the side, and wins when the two disagree.
+                float eta = entering ? s.material.ior : 1 / s.material.ior;
+                Vec3 ng = entering ? h.n : -h.n;  // faces the incoming ray
+                Vec3 n = dot(h.ns, ng) > 0 ? h.ns : -h.ns;
+                if (-dot(ray.d, n) <= 0) n = ng;  // shading normal faces away from the ray
+                float cosI = -dot(ray.d, n), cosT;
+                float F = fresnelDielectric(cosI, eta, &cosT);
+                bool reflect = rng.uniform() < F;
+                Vec3 d = reflect ? ray.d + n * (2 * cosI) : ray.d / eta + n * (cosI / eta - cosT);
+                if (reflect ? dot(d, ng) <= 0 : dot(d, ng) >= 0) {
+                    // The shading normal sent the ray to the wrong side of
+                    // the true surface: redo the event with the geometric one.
+                    cosI = -dot(ray.d, ng);
+                    F = fresnelDielectric(cosI, eta, &cosT);
+                    reflect = reflect || F >= 1;
+                    d = reflect ? ray.d + ng * (2 * cosI) : ray.d / eta + ng * (cosI / eta - cosT);
+                }
+                if (!reflect) region = entering ? s.interiorRegion : s.exteriorRegion;
+                d = normalize(d);
+                ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
+                break;
+            }
+        }
+    }
+}
+
+CacheLookup& SegmentMarcher::cacheLookup(ThreadContext& ctx) const {
+    if (!ctx.cacheLookup) ctx.cacheLookup = std::make_unique<CacheLookup>(*mIllumination->cache);
+    return *ctx.cacheLookup;
+}
+
+Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
+                                  const MediumPoint& mp, Rng& rng) const {
+    if (mp.count == 0) return Color(0);
+    ++ctx.counters.liSamples;
+    const Illumination& il = *mIllumination;
+    if (il.liFromCache) {
+        if (!il.cache) return Color(0);  // nothing scatters anywhere
+        CacheLookup& c = cacheLookup(ctx);
+        c.setDirection(-rayDir);
+        return Color(c.at(x));
+    }
+    Color Li = directInScattering(ctx, region, x, rayDir, mp, rng);
+    if (il.indirect)
+        Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return phaseMixture(mp, c); });
+    return Li;
+}
+
+namespace {
+
+// Skipped = the part of [0, end) outside active intervals, where `end` is the
+// segment end or, for rays to infinity, the end of the last interval.
+void addLengths(ThreadContext& ctx, float tEnd, const std::vector<Interval>& intervals) {
+    double active = 0;
+    for (const Interval& iv : intervals) active += double(std::min(iv.t1, 1e30f) - iv.t0);
+    ctx.counters.marchedLength += active;
+    double end = std::isfinite(tEnd) ? double(tEnd)
+                                     : (intervals.empty() ? 0.0 : double(std::min(intervals.back().t1, 1e30f)));
+    ctx.counters.skippedLength += std::max(0.0, end - active);
+}
+
+}  // namespace
+
+bool SegmentMarcher::activeIntervals(ThreadContext& ctx, int region, const Ray& ray, float tEnd,
+                                     bool& infiniteTail) const {
+    infiniteTail = false;
+    if (mScene.regions[size_t(region)].media.empty()) return false;
+    // Past the scene's finite content unbounded fog is homogeneous: march
+    // until its transmittance is below e^-20 (at most 1e5 steps).
+    const Color& K = mScene.regions[size_t(region)].unboundedSigmaT;
+    infiniteTail = !std::isfinite(tEnd) && !isBlack(K);
+    float tLimit = tEnd;
+    if (infiniteTail) {
+        float kMin = Infinity;
+        for (int c = 0; c < 3; ++c)
+            if (K[c] > 0) kMin = std::min(kMin, K[c]);
+        tLimit = length(ray.o) + 2 * mScene.sceneScale + std::min(20.f / kMin, 1e5f * mScene.step);
+    }
+    regionIntervals(ctx, region, ray, 0.f, tLimit, ctx.intervals);
+    addLengths(ctx, tEnd, ctx.intervals);
+    return true;
+}
+
+void SegmentMarcher::applyInfiniteTail(int region, Color& beta) const {
+    const Color& K = mScene.regions[size_t(region)].unboundedSigmaT;
+    for (int c = 0; c < 3; ++c)
+        if (K[c] > 0) beta[c] = 0;
+}
+
+StepTerms stepTerms(const MediumPoint& mp, float dx) {
+    StepTerms s;
+    for (int c = 0; c < 3; ++c) {
+        float kappa = mp.sigma_t[c];
+        float tauStep = kappa * dx;
+        s.T[c] = std::exp(-tauStep);
+        float oneMinusT = tauStep > 1e-4f ? -std::expm1(-tauStep) : tauStep * (1 - 0.5f * tauStep);
+        s.absorbedA[c] = kappa > 0 ? oneMinusT * (mp.sigma_a[c] / kappa) : 0.f;
+        s.absorbedS[c] = kappa > 0 ? oneMinusT * (mp.sigma_s[c] / kappa) : 0.f;
+    }
+    return s;
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,186 @@
+// The per-ray pdf of the transmittance and guided marchers (eqs. 9, 16-18):
+// normalisation, chi-square of its samples, and the guided estimator's
+// expectation against quadrature of the same integrand along a ray, for a
+// good histogram, a negative-ringing (clamped) one and an empty one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "chi_square.h"
+#include "core/rng.h"
+#include "marchers/ray_pdf.h"
+
+namespace vdbmarch {
+namespace {
+
+using testing::chiSquareQ;
+
+// A synthetic ray: 60 steps of 0.05 with varying extinction, some of them
+// not scattering (sigma_s = 0), through a medium of optical depth ~ 3.
+struct SyntheticRay {
+    std::vector<PdfStep> steps;
+    std::vector<double> sigmaS, kappa, T0;
+    SyntheticRay() {
+        double T = 1, t = 0;
+        for (int k = 0; k < 60; ++k) {
+            double len = 0.05, kap = 0.5 + 1.5 * (1 + std::sin(0.37 * k)), ss = (k >= 20 && k < 26) ? 0.0 : 0.8 * kap;
+            double S = -std::expm1(-kap * len) / kap;
+            steps.push_back({float(t), float(len), float(kap), float(ss * T * S)});
+            sigmaS.push_back(ss);
+            kappa.push_back(kap);
+            T0.push_back(T);
+            T *= std::exp(-kap * len);
+            t += len;
+        }
+    }
+    // T(t) sigma_s on step k at offset x.
+    double weight(int k, double x) const { return T0[size_t(k)] * std::exp(-kappa[size_t(k)] * x) * sigmaS[size_t(k)]; }
+};
+
+// L_i along the ray: two sharp peaks (widths 0.01 and 0.03) on a dim floor,
+// and a dark region [2.2, 2.5).
+double syntheticLi(double t) {
+    if (t >= 2.2 && t < 2.5) return 0;
+    return 0.05 + 40 * std::exp(-0.5 * std::pow((t - 0.63) / 0.01, 2)) + 5 * std::exp(-0.5 * std::pow((t - 1.71) / 0.03, 2));
+}
+
+// Quadrature of sum_k int_step T sigma_s L_i (Simpson, 2000 panels per step).
+double quadrature(const SyntheticRay& r) {
+    double sum = 0;
+    for (size_t k = 0; k < r.steps.size(); ++k) {
+        const int n = 2000;
+        const double h = r.steps[k].len / n;
+        for (int i = 0; i <= n; ++i) {
+            double x = i * h, w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+            sum += w * r.weight(int(k), x) * syntheticLi(r.steps[k].t0 + x) * h / 3;
+        }
+    }
+    return sum;
+}
+
+TEST(RayPdf, IntegratesToOneAndMatchesItsSamples) {
+    SyntheticRay r;
+    std::vector<float> h;
+    for (const auto& s : r.steps) h.push_back(float(syntheticLi(s.t0 + 0.5 * s.len)));
+    for (bool guided : {false, true}) {
+        RayPdf pdf;
+        pdf.build(r.steps, guided ? h.data() : nullptr);
+        ASSERT_TRUE(pdf.valid());
+        // Normalisation by Simpson quadrature of pdf(step, x).
+        double integral = 0;
+        for (int k = 0; k < int(r.steps.size()); ++k) {
+            const int n = 200;
+            const double dx = r.steps[size_t(k)].len / n;
+            for (int i = 0; i <= n; ++i)
+                integral += ((i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2)) * pdf.pdf(k, float(i * dx)) * dx / 3;
+        }
+        EXPECT_NEAR(integral, 1.0, 1e-5);
+        // Chi-square over 4 sub-bins per step, expected counts from the pdf
+        // integrated by quadrature; non-scattering steps must get no sample.
+        const int sub = 4, samples = 400000;
+        std::vector<double> observed(r.steps.size() * sub, 0), expected(r.steps.size() * sub, 0);
+        Rng rng(guided ? 7 : 8);
+        for (int i = 0; i < samples; ++i) {
+            int k;
+            float x;
+            double p;
+            pdf.sample(rng.uniform(), k, x, p);
+            ASSERT_GE(x, 0.f);
+            ASSERT_LT(x, r.steps[size_t(k)].len);
+            ASSERT_NEAR(p, pdf.pdf(k, x), 1e-9 * p);
+            ASSERT_GT(r.sigmaS[size_t(k)], 0) << "sampled a step that cannot scatter";
+            observed[size_t(k) * sub + size_t(std::min(sub - 1, int(x / r.steps[size_t(k)].len * sub)))] += 1;
+        }
+        for (size_t b = 0; b < expected.size(); ++b) {
+            const PdfStep& s = r.steps[b / sub];
+            const double a = s.len * double(b % sub) / sub, c = s.len * double(b % sub + 1) / sub;
+            const int n = 100;
+            for (int i = 0; i <= n; ++i)
+                expected[b] += ((i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2)) *
+                               pdf.pdf(int(b / sub), float(a + i * (c - a) / n)) * (c - a) / n / 3 * samples;
+        }
+        // Pool bins with small expectations, as the chi-square test needs.
+        double chi2 = 0, accO = 0, accE = 0;
+        int dof = -1;
+        for (size_t b = 0; b < expected.size(); ++b) {
+            accO += observed[b];
+            accE += expected[b];
+            if (accE >= 20 || b + 1 == expected.size()) {
+                if (accE > 0) {
+                    chi2 += (accO - accE) * (accO - accE) / accE;
+                    ++dof;
+                }
+                accO = accE = 0;
+            }
+        }
+        EXPECT_GT(chiSquareQ(chi2, dof), 1e-4) << "chi2 " << chi2 << " dof " << dof << (guided ? " guided" : "");
+    }
+}
+
+struct EstimatorStats {
+    double mean = 0, stdError = 0, variance = 0;
+};
+
+// Eq. 18 with N stratified samples, repeated: mean, its standard error and
+// the per-estimate variance.
+EstimatorStats estimate(const SyntheticRay& r, const float* h, int n, int repeats, uint64_t seed) {
+    RayPdf pdf;
+    pdf.build(r.steps, h);
+    Rng rng(seed);
+    double sum = 0, sum2 = 0;
+    for (int rep = 0; rep < repeats; ++rep) {
+        double e = 0;
+        for (int j = 0; j < n; ++j) {
+            int k;
+            float x;
+            double p;
+            pdf.sample((j + rng.uniform()) / n, k, x, p);
+            e += r.weight(k, x) * syntheticLi(r.steps[size_t(k)].t0 + x) / (n * p);
+        }
+        sum += e;
+        sum2 += e * e;
+    }
+    EstimatorStats s;
+    s.mean = sum / repeats;
+    s.variance = (sum2 / repeats - s.mean * s.mean) * repeats / (repeats - 1);
+    s.stdError = std::sqrt(s.variance / repeats);
+    return s;
+}
+
+TEST(RayPdf, GuidedEstimatorIsUnbiasedForAnyHistogram) {
+    SyntheticRay r;
+    const double truth = quadrature(r);
+    // A good histogram: L_i at the step centres (sharper than the cache's cells).
+    std::vector<float> good, ringing, empty(r.steps.size(), 0.f), wrong;
+    for (size_t k = 0; k < r.steps.size(); ++k) {
+        const double t = r.steps[k].t0 + 0.5 * r.steps[k].len;
+        good.push_back(float(syntheticLi(t)));
+        // Ringing: an SH-like overshoot that goes negative next to the peak
+        // and is clamped to 0 there, where L_i is not 0.
+        double ring = syntheticLi(t) + 8 * std::sin(9 * t);
+        ringing.push_back(float(std::max(0.0, ring)));
+        // Wrong: light only where L_i is dark.
+        wrong.push_back(t >= 2.2 && t < 2.5 ? 10.f : 0.f);
+    }
+    const int n = 4, repeats = 20000;
+    EstimatorStats transmittance = estimate(r, nullptr, n, repeats, 1);
+    struct Case {
+        const char* name;
+        const float* h;
+    } cases[] = {{"good", good.data()}, {"ringing", ringing.data()}, {"empty", empty.data()}, {"wrong", wrong.data()}};
+    EXPECT_NEAR(transmittance.mean, truth, 4 * transmittance.stdError) << "transmittance";
+    for (const auto& c : cases) {
+        EstimatorStats s = estimate(r, c.h, n, repeats, 2);
+        EXPECT_NEAR(s.mean, truth, 4 * s.stdError) << c.name;
+        // Defensive mixing bounds the loss to 1/eps of transmittance's variance.
+        EXPECT_LT(s.variance, transmittance.variance / RayPdf::DefaultDefensive) << c.name;
+        if (c.h == good.data()) {
+            EXPECT_LT(s.variance, 0.1 * transmittance.variance) << "a good histogram must pay off";
+        }
+    }
+}
+
+}  // namespace
+}  // namespace vdbmarch
