@@ -5,9 +5,20 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
 #include "cache/sh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "marchers/illumination.h"
+#include "marchers/march_common.h"
+#include "marchers/marcher.h"
+#include "marchers/segment_marcher.h"
+#include "scene/scene.h"
+#include "scene/scene_desc.h"
 #include "volume/medium.h"
 
 using namespace vdbmarch;
@@ -121,6 +132,199 @@ void BM_EvalSh(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()));
 }
 BENCHMARK(BM_EvalSh)->Arg(3)->Arg(8);
+
+// ---------------------------------------------------------------------------
+// Issue 5: the cost of one march sample against one trilinear density lookup
+// on the same grid (target: at most 3x).
+//
+//   vdbmarch_kernels --benchmark_filter='Trilinear|MarchSample' \
+//       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+//
+// Scene (built in code through the scene parser): vdb_samples/cloud.vdb with
+// sigma_a 0.3, sigma_s 5, g 0.8, the sample's directional light and camera,
+// black background (so L_i is one shadow ray to the light, no environment
+// ray), render.max_depth 1 (single scattering: no photon map for L_i), the
+// automatic step (one voxel, 0.016). Camera rays: pixel centres of a 64x48
+// grid over the 640x480 frame, keeping the rays whose empty-space intervals
+// are not empty (rays that miss every active block do no marching). Every
+// iteration traces the same rays with the same random streams, so every
+// iteration does the same work.
+
+struct MarchBench {
+    std::unique_ptr<Scene> scene;
+    std::vector<Ray> rays;
+};
+
+std::unique_ptr<Scene> benchScene(const std::string& method, const std::string& li, int raySamples) {
+    const std::string json = R"({
+  "camera": { "position": [1.47, 0.88, 3.25], "look_at": [0.0, 0.17, 0.0], "fov_deg": 35,
+              "resolution": [640, 480] },
+  "lights": [ { "type": "directional", "direction": [0.55, -0.75, -0.35], "irradiance": [6.4, 6.0, 5.4] } ],
+  "media": [ { "name": "cloud", "type": "vdb", "file": "cloud.vdb",
+               "sigma_a": 0.3, "sigma_s": 5.0, "g": 0.8 } ],
+  "background": 0,
+  "render": { "method": ")" + method + R"(", "max_depth": 1, "seed": 1, "li": ")" + li +
+                             R"(", "ray_samples": )" + std::to_string(raySamples) + R"( }
+})";
+    // The file name only places relative paths (cloud.vdb) and names errors.
+    return buildScene(parseSceneText(json, std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/kernels_bench.json"));
+}
+
+// Camera rays through the cloud (see above); the same for every variant.
+std::vector<Ray> benchRays(const Scene& scene) {
+    ThreadContext ctx(scene);
+    std::vector<Ray> rays;
+    const int gw = 64, gh = 48, w = scene.camera->width(), h = scene.camera->height();
+    for (int j = 0; j < gh; ++j)
+        for (int i = 0; i < gw; ++i) {
+            Ray r = scene.camera->generateRay((float(i) + 0.5f) * float(w) / gw, (float(j) + 0.5f) * float(h) / gh);
+            regionIntervals(ctx, Scene::WorldRegion, r, 0.f, Infinity, ctx.intervals);
+            if (!ctx.intervals.empty()) rays.push_back(r);
+        }
+    return rays;
+}
+
+uint64_t raySeed(size_t i) { return hashValues(0x6b65726e656c, uint64_t(i)); }
+
+// One scene per (li, ray_samples), loaded once per process.
+MarchBench& marchBench(const std::string& li, int raySamples) {
+    static std::map<std::string, std::unique_ptr<MarchBench>> all;
+    auto& b = all[li + "/" + std::to_string(raySamples)];
+    if (!b) {
+        b = std::make_unique<MarchBench>();
+        b->scene = benchScene("guided", li, raySamples);
+        b->rays = benchRays(*b->scene);
+    }
+    return *b;
+}
+
+// The points where the sampled marchers look the density up along those
+// rays, in marching order: steps [k dx, (k + 1) dx) clipped to the active
+// intervals, one point per step at the ray's jittered offset (the first
+// uniform of the ray's stream, as in SampledMarcher::marchSegment), until the
+// transmittance drops below the roulette threshold (where the marcher plays
+// Russian roulette; the few survivors are not followed here).
+const std::vector<Vec3>& marchPoints() {
+    static const std::vector<Vec3> pts = [] {
+        MarchBench& b = marchBench("photons", 4);
+        const Scene& scene = *b.scene;
+        ThreadContext ctx(scene);
+        const Medium& m = *scene.media[0];
+        const float sigmaT = maxComponent(m.sigma_a + m.sigma_s);
+        const double dx = double(scene.step);
+        std::vector<Vec3> out;
+        for (size_t i = 0; i < b.rays.size(); ++i) {
+            const Ray& ray = b.rays[i];
+            Rng rng(raySeed(i));
+            const double u = double(rng.uniform());
+            regionIntervals(ctx, Scene::WorldRegion, ray, 0.f, Infinity, ctx.intervals);
+            float T = 1;
+            for (const Interval& iv : ctx.intervals) {
+                for (double k = std::floor(double(iv.t0) / dx); T >= RouletteThreshold; k += 1) {
+                    const double a = std::max(double(iv.t0), k * dx), b1 = std::min(double(iv.t1), (k + 1) * dx);
+                    if (a >= double(iv.t1)) break;
+                    if (!(b1 > a)) continue;
+                    const Vec3 x = ray.at(float(a + u * (b1 - a)));
+                    out.push_back(x);
+                    T *= std::exp(-sigmaT * ctx.queries[0]->density(x) * float(b1 - a));
+                }
+                if (T < RouletteThreshold) break;
+            }
+        }
+        return out;
+    }();
+    return pts;
+}
+
+// One trilinear density lookup (MediumQuery::density: the padded-block
+// sampler with its per-thread block cache) at the march points above, in
+// order: the access pattern of marching, timed without anything else.
+void BM_TrilinearDensityLookup(benchmark::State& state) {
+    MarchBench& b = marchBench("photons", 4);
+    const auto& pts = marchPoints();
+    auto q = b.scene->media[0]->makeQuery();
+    size_t i = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(q->density(pts[i]));
+        if (++i == pts.size()) i = 0;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()));
+    state.counters["points"] = double(pts.size());
+}
+BENCHMARK(BM_TrilinearDensityLookup);
+
+// evalMedia at the same points: the lookup plus the per-step coefficients
+// (sigma_a, sigma_s, sigma_t colours, phase-mixture entry) every marcher
+// computes from it. Part of a march sample, shown to split its cost.
+void BM_TrilinearEvalMedia(benchmark::State& state) {
+    MarchBench& b = marchBench("photons", 4);
+    const auto& pts = marchPoints();
+    ThreadContext ctx(*b.scene);
+    MediumPoint mp;
+    size_t i = 0;
+    for (auto _ : state) {
+        evalMedia(ctx, Scene::WorldRegion, pts[i], mp);
+        benchmark::DoNotOptimize(mp);
+        if (++i == pts.size()) i = 0;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_TrilinearEvalMedia);
+
+// Time per march sample of a sampled marcher: one iteration is
+// marcher->radiance() over every bench ray; the CPU time is divided by
+// ThreadContext.counters.marchSamples (one per step of the per-ray walk), so
+// a march sample's cost here includes everything amortised over the walk:
+// active intervals, the histogram and its CDF (RayPdf), for guided the cache
+// lookups h(t), and the L_i estimates at the positions drawn from the pdf.
+// Counters (per camera ray): march_samples, li_samples (points where L_i was
+// estimated), shadow_samples (medium samples along shadow rays).
+//   li_photons_rs4: render.li "photons", ray_samples 4 (the default): L_i =
+//                   one shadow ray to the directional light per L_i sample
+//                   (max_depth 1: no photon map). The full cost.
+//   li_photons_rs1: the same with ray_samples 1: fewer shadow rays per walk.
+//   li_cache_rs4:   render.li "cache": L_i is one radiance-cache lookup, so
+//                   the time is (almost) the pure walk + histogram + sampling.
+// Guided falls back to transmittance sampling without a cache; it always has
+// one here (the Illumination is prepared for "guided").
+void marchSampleBench(benchmark::State& state, const std::string& method, const std::string& li, int raySamples) {
+    MarchBench& b = marchBench(li, raySamples);
+    // Photons, cache and (guided) the eq. 17 pre-pass, once per process.
+    static std::map<std::string, std::unique_ptr<Marcher>> marchers;
+    auto& marcher = marchers[method + "/" + li + "/" + std::to_string(raySamples)];
+    if (!marcher)
+        marcher = makeMarcher(method, *b.scene,
+                              std::make_shared<Illumination>(prepareIllumination(*b.scene, method)));
+    ThreadContext ctx(*b.scene);
+    for (auto _ : state) {
+        for (size_t i = 0; i < b.rays.size(); ++i) {
+            Rng rng(raySeed(i));
+            benchmark::DoNotOptimize(marcher->radiance(b.rays[i], rng, ctx));
+        }
+    }
+    const RenderCounters& c = ctx.counters;
+    const double rays = double(c.cameraRays);
+    state.SetItemsProcessed(int64_t(c.marchSamples));
+    state.counters["time_per_march_sample"] =
+        benchmark::Counter(double(c.marchSamples), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.counters["march_samples_per_ray"] = double(c.marchSamples) / rays;
+    state.counters["li_samples_per_ray"] = double(c.liSamples) / rays;
+    state.counters["shadow_samples_per_ray"] = double(c.shadowSamples) / rays;
+    state.counters["rays"] = double(b.rays.size());
+}
+
+void BM_GuidedMarchSample(benchmark::State& state, const char* li, int raySamples) {
+    marchSampleBench(state, "guided", li, raySamples);
+}
+void BM_TransmittanceMarchSample(benchmark::State& state, const char* li, int raySamples) {
+    marchSampleBench(state, "transmittance", li, raySamples);
+}
+BENCHMARK_CAPTURE(BM_GuidedMarchSample, li_photons_rs4, "photons", 4)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GuidedMarchSample, li_photons_rs1, "photons", 1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GuidedMarchSample, li_cache_rs4, "cache", 4)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_photons_rs4, "photons", 4)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_photons_rs1, "photons", 1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_cache_rs4, "cache", 4)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -51,7 +51,9 @@ std::string resolutionOverride(const std::string& res) {
 }
 
 struct RenderArgs {
-    std::string input, output, png, method, res, stats, saveScene;
+    std::string input, output, png, method, res, stats, saveScene, cache, li;
+    int shOrder = 0, raySamples = 0;
+    bool shOrderSet = false, raySamplesSet = false, force = false;
     // Options the user did not give keep the scene's values; given ones are
     // validated by the scene parser like any other key.
     int spp = 0, threads = 0;
@@ -95,12 +97,20 @@ int runRender(const RenderArgs& a) {
     if (a.stepSet) overrides.push_back(str("render.step=", a.step));
     if (a.exposureSet) overrides.push_back(str("render.exposure=", a.exposure));
     if (!a.res.empty()) overrides.push_back(resolutionOverride(a.res));
+    if (!a.li.empty()) overrides.push_back("render.li=\"" + a.li + "\"");
+    if (a.raySamplesSet) overrides.push_back(str("render.ray_samples=", a.raySamples));
+    if (a.shOrderSet) overrides.push_back(str("cache.sh_order=", a.shOrder));
+    if (!a.cache.empty() && !endsWith(a.cache, ".vdb"))
+        throw InputError(str("--cache ", a.cache, ": the cache must be a .vdb file written by vdbmarch bake"));
+    if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
 
     SceneDesc desc = endsWith(a.input, ".vdb") ? loadAutoScene(a.input, overrides) : loadSceneFile(a.input, overrides);
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     RenderOptions options;
+    options.illumination.cacheFile = a.cache;
+    options.illumination.force = a.force;
     options.progress = !a.quiet && !a.noProgress && isatty(STDERR_FILENO);
     if (a.timeSet) {
         options.timeBudget = a.timeBudget;
@@ -129,7 +139,10 @@ int runRender(const RenderArgs& a) {
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) {
         nlohmann::json s;
-        s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"total", total}};
+        s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"photons_and_cache", r.illuminationSeconds},
+                        {"total", total}};
+        s["photons"] = r.photons;
+        s["cache_cells"] = r.cacheCells;
         s["threads"] = r.threads;
         s["method"] = desc.render.method;
         s["spp"] = r.spp;
@@ -145,9 +158,13 @@ int runRender(const RenderArgs& a) {
         writeTextFileAtomic(a.stats, s.dump(2) + "\n");
     }
     if (!a.quiet)
-        std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (load %.3f s, total %.3f s) -> %s%s%s\n",
+        std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
                      r.image.width, r.image.height, r.spp, desc.render.method.c_str(), double(scene->step),
-                     r.seconds, loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
+                     r.seconds,
+                     r.illuminationSeconds > 0
+                         ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s, ").c_str()
+                         : "",
+                     loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
     return 0;
 }
 
@@ -373,6 +390,16 @@ int main(int argc, char** argv) {
     render->add_option("--stats", ra.stats, "Write timings and counters as JSON");
     render->add_option("--save-scene", ra.saveScene,
                        "Write the effective scene (after --set and options; the generated one for a .vdb) as JSON");
+    render->add_option("--li", ra.li,
+                       "How marchers estimate L_i: photons (shadow rays + non-direct photons, default) or cache "
+                       "(the radiance cache alone: fast, biased preview)");
+    render->add_option("--ray-samples", ra.raySamples,
+                       "L_i samples per ray segment for transmittance and guided (render.ray_samples)")
+        ->each(flagSet(ra.raySamplesSet));
+    render->add_option("--sh-order", ra.shOrder, "SH order of the cache built for guided; 0 = scalar cache (cache.sh_order)")
+        ->each(flagSet(ra.shOrderSet));
+    render->add_option("--cache", ra.cache, "Use this baked cache (vdbmarch bake) instead of building one");
+    render->add_flag("--force", ra.force, "Use a --cache baked for another scene (warns)");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or summary line");
     render->add_flag("--no-progress", ra.noProgress, "No progress bar");
 

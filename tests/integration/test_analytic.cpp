@@ -88,7 +88,7 @@ TEST_P(SingleScatteringSlab, MatchesClosedForm) {
         "media": [{"type": "homogeneous", "sigma_a": 0.2, "sigma_s": 0.8, "g": )", g, R"(,
                    "bounds": {"min": [-10, -10, -0.5], "max": [10, 10, 0.5]}}],
         "render": {"step": 0.01, "seed": 11, "max_depth": 1, "method": ")", method, R"(",
-                   "spp": )", method == "reference" ? 16 : 1, "}}"));
+                   "spp": )", method == "uniform" ? 1 : 16, "}}"));
     RenderResult r = renderImage(*scene);
     // Phase argument: cos between the light's travel direction and the view ray's.
     double p = hgPhase(float(-mu), g);
@@ -103,7 +103,8 @@ TEST_P(SingleScatteringSlab, MatchesClosedForm) {
 
 INSTANTIATE_TEST_SUITE_P(Anisotropy, SingleScatteringSlab,
                          ::testing::Combine(::testing::Values(0.f, 0.9f, -0.9f),
-                                            ::testing::Values(std::string("uniform"), std::string("reference"))),
+                                            ::testing::Values(std::string("uniform"), std::string("transmittance"),
+                                                              std::string("guided"), std::string("reference"))),
                          [](const auto& info) {
                              float g = std::get<0>(info.param);
                              return std::get<1>(info.param) + (g == 0 ? "_g0" : (g > 0 ? "_gPlus09" : "_gMinus09"));

@@ -1,0 +1,107 @@
+// Method agreement: uniform (small step), transmittance and guided converge
+// to the reference path tracer's image, on a heterogeneous VDB cloud under a
+// spotlight and on a glass sphere holding smoke lit by a sphere light, with
+// multiple scattering (max_depth 4). The marchers' L_i is exact for direct
+// light (shadow rays) and takes the rest from the photon map, whose kNN
+// estimate is consistent but biased at a finite photon count: the tolerance
+// is the paired test's 4 standard errors plus that bias, bounded by the
+// fraction `photonBias` of the image mean (justified below).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "core/error.h"
+#include "render.h"
+#include "test_helpers.h"
+
+namespace vdbmarch::testing {
+namespace {
+
+struct Agreement {
+    double meanDiff = 0, stdError = 0, mean = 0, relMse = 0;
+};
+
+// Paired per-pixel differences over the image (all channels): their mean is
+// zero when two estimators agree, and their spread is the two noises.
+Agreement compare(const Image& test, const Image& ref) {
+    double s = 0, s2 = 0, m = 0, r2 = 0;
+    size_t n = 0;
+    for (int y = 0; y < ref.height; ++y)
+        for (int x = 0; x < ref.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                double d = double(test.rgb(x, y)[c]) - double(ref.rgb(x, y)[c]);
+                s += d;
+                s2 += d * d;
+                m += double(ref.rgb(x, y)[c]);
+                r2 += double(ref.rgb(x, y)[c]) * double(ref.rgb(x, y)[c]);
+                ++n;
+            }
+    Agreement a;
+    a.meanDiff = s / double(n);
+    a.stdError = std::sqrt(std::max(0.0, s2 / double(n) - a.meanDiff * a.meanDiff) / double(n - 1));
+    a.mean = m / double(n);
+    a.relMse = s2 / std::max(r2, 1e-30);
+    return a;
+}
+
+Image render(const std::string& sceneFile, const std::vector<std::string>& common, const std::string& method, int spp) {
+    std::vector<std::string> o = common;
+    o.push_back("render.method=\"" + method + "\"");
+    o.push_back(str("render.spp=", spp));
+    return renderImage(*buildScene(loadSceneFile(sceneFile, o))).image;
+}
+
+void checkAgreement(const std::string& name, const std::string& sceneFile, const std::vector<std::string>& common,
+                    int referenceSpp, double photonBias) {
+    Image ref = render(sceneFile, common, "reference", referenceSpp);
+    struct Run {
+        const char* method;
+        int spp;
+        std::vector<std::string> extra;
+    } runs[] = {{"uniform", 4, {"render.step=0.01"}}, {"transmittance", 32, {}}, {"guided", 32, {}}};
+    for (const auto& run : runs) {
+        std::vector<std::string> o = common;
+        o.insert(o.end(), run.extra.begin(), run.extra.end());
+        Agreement a = compare(render(sceneFile, o, run.method, run.spp), ref);
+        EXPECT_NEAR(a.meanDiff, 0.0, 4 * a.stdError + photonBias * a.mean) << name << ": " << run.method;
+        if (std::getenv("VDBMARCH_VERBOSE"))
+            std::printf("%s %s: mean diff %.4g (%.2f%% of mean %.4g), SE %.3g, relMSE %.4g\n", name.c_str(), run.method,
+                        a.meanDiff, 100 * a.meanDiff / a.mean, a.mean, a.stdError, a.relMse);
+    }
+}
+
+// The photon map's share: indirect light is a fraction of these images, and
+// the kNN estimate of it is within a few percent where the photon density is
+// smooth (PhotonMapAccuracy tests, 4 SE at k = 100); at the edges of beams and
+// of the glass its blur can move a larger share. Measured (VDBMARCH_VERBOSE=1,
+// 2026-11-22): transmittance and guided differ from the reference by -1.8%
+// and -1.7% of the image mean on the cloud (2.4 and 2.3 SE), +1.6% and +1.7%
+// on the glass (1.4 SE); 3% bounds that bias with margin.
+constexpr double PhotonBias = 0.03;
+
+TEST(MarcherAgreement, VdbCloudUnderASpotlight) {
+    const std::string scene = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
+    checkAgreement("cloud+spot", scene,
+                   {"camera.resolution=[32,24]", "render.max_depth=4", "render.seed=3",
+                    R"(media=[{"name": "cloud", "type": "vdb", "file": "cloud.vdb", "sigma_a": 0.3, "sigma_s": 6, "g": 0.6}])",
+                    R"(lights=[{"type": "spot", "position": [-1.2, 1.6, 1.0], "direction": [0.6, -0.7, -0.45],
+                               "intensity": [8, 8, 8], "cone_deg": 14, "falloff_deg": 4}])",
+                    "background=0"},
+                   512, PhotonBias);
+}
+
+TEST(MarcherAgreement, GlassSphereWithSmokeUnderASphereLight) {
+    const std::string scene = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/glass.json";
+    checkAgreement("glass+sphere light", scene,
+                   {"camera.resolution=[32,24]", "render.max_depth=4", "render.seed=3",
+                    R"(lights=[{"type": "sphere", "position": [-1.0, 1.6, 0.8], "radius": 0.25, "power": [60, 55, 50]}])",
+                    // No floor: the marchers light diffuse surfaces by direct light only.
+                    R"(surfaces=[{"shape": "sphere", "transform": {"scale": 0.7},
+                                  "material": {"type": "dielectric", "ior": 1.5}, "interior": "smoke", "exterior": "fog"}])"},
+                   512, PhotonBias);
+}
+
+}  // namespace
+}  // namespace vdbmarch::testing
