@@ -137,7 +137,7 @@ BENCHMARK(BM_EvalSh)->Arg(3)->Arg(8);
 // Issue 5: the cost of one march sample against one trilinear density lookup
 // on the same grid (target: at most 3x).
 //
-//   vdbmarch_kernels --benchmark_filter='Trilinear|MarchSample' \
+//   vdbmarch_kernels --benchmark_filter='Trilinear|MarchSample'
 //       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //
 // Scene (built in code through the scene parser): vdb_samples/cloud.vdb with
@@ -155,13 +155,16 @@ struct MarchBench {
     std::vector<Ray> rays;
 };
 
-std::unique_ptr<Scene> benchScene(const std::string& method, const std::string& li, int raySamples) {
+// absorbing: sigma_a 5.3, sigma_s 0 (the same extinction, so the same walk,
+// but nothing scatters: no histogram, no L_i).
+std::unique_ptr<Scene> benchScene(const std::string& method, const std::string& li, int raySamples, bool absorbing) {
+    const std::string coefficients = absorbing ? R"("sigma_a": 5.3, "sigma_s": 0.0)" : R"("sigma_a": 0.3, "sigma_s": 5.0)";
     const std::string json = R"({
   "camera": { "position": [1.47, 0.88, 3.25], "look_at": [0.0, 0.17, 0.0], "fov_deg": 35,
               "resolution": [640, 480] },
   "lights": [ { "type": "directional", "direction": [0.55, -0.75, -0.35], "irradiance": [6.4, 6.0, 5.4] } ],
   "media": [ { "name": "cloud", "type": "vdb", "file": "cloud.vdb",
-               "sigma_a": 0.3, "sigma_s": 5.0, "g": 0.8 } ],
+               )" + coefficients + R"(, "g": 0.8 } ],
   "background": 0,
   "render": { "method": ")" + method + R"(", "max_depth": 1, "seed": 1, "li": ")" + li +
                              R"(", "ray_samples": )" + std::to_string(raySamples) + R"( }
@@ -186,13 +189,13 @@ std::vector<Ray> benchRays(const Scene& scene) {
 
 uint64_t raySeed(size_t i) { return hashValues(0x6b65726e656c, uint64_t(i)); }
 
-// One scene per (li, ray_samples), loaded once per process.
-MarchBench& marchBench(const std::string& li, int raySamples) {
+// One scene per (li, ray_samples, absorbing), loaded once per process.
+MarchBench& marchBench(const std::string& li, int raySamples, bool absorbing = false) {
     static std::map<std::string, std::unique_ptr<MarchBench>> all;
-    auto& b = all[li + "/" + std::to_string(raySamples)];
+    auto& b = all[li + "/" + std::to_string(raySamples) + (absorbing ? "/absorbing" : "")];
     if (!b) {
         b = std::make_unique<MarchBench>();
-        b->scene = benchScene("guided", li, raySamples);
+        b->scene = benchScene("guided", li, raySamples, absorbing);
         b->rays = benchRays(*b->scene);
     }
     return *b;
@@ -253,6 +256,26 @@ void BM_TrilinearDensityLookup(benchmark::State& state) {
 }
 BENCHMARK(BM_TrilinearDensityLookup);
 
+// The same lookups made serial: the next point's index depends on the last
+// result (the added term is always 0), so consecutive lookups cannot overlap
+// in the out-of-order core. This is the latency of one lookup, the figure a
+// march step sees when the rest of the step (exponentials, histogram, branches
+// on the density) fills the reorder window between two lookups; the plain
+// benchmark above is the throughput of back-to-back independent lookups.
+void BM_TrilinearDensityLookupLatency(benchmark::State& state) {
+    MarchBench& b = marchBench("photons", 4);
+    const auto& pts = marchPoints();
+    auto q = b.scene->media[0]->makeQuery();
+    size_t i = 0;
+    for (auto _ : state) {
+        const float d = q->density(pts[i]);
+        i += 1 + size_t(d < 0);  // density is >= 0: always + 1, but only known after the lookup
+        if (i >= pts.size()) i = 0;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_TrilinearDensityLookupLatency);
+
 // evalMedia at the same points: the lookup plus the per-step coefficients
 // (sigma_a, sigma_s, sigma_t colours, phase-mixture entry) every marcher
 // computes from it. Part of a march sample, shown to split its cost.
@@ -285,13 +308,18 @@ BENCHMARK(BM_TrilinearEvalMedia);
 //   li_photons_rs1: the same with ray_samples 1: fewer shadow rays per walk.
 //   li_cache_rs4:   render.li "cache": L_i is one radiance-cache lookup, so
 //                   the time is (almost) the pure walk + histogram + sampling.
+//   walk_only:      (transmittance) the medium made purely absorbing with the
+//                   same extinction (sigma_a 5.3, sigma_s 0): the same steps,
+//                   but no histogram, pdf or L_i. The bare walk: intervals,
+//                   evalMedia, the step's exponentials, roulette.
 // Guided falls back to transmittance sampling without a cache; it always has
 // one here (the Illumination is prepared for "guided").
-void marchSampleBench(benchmark::State& state, const std::string& method, const std::string& li, int raySamples) {
-    MarchBench& b = marchBench(li, raySamples);
+void marchSampleBench(benchmark::State& state, const std::string& method, const std::string& li, int raySamples,
+                      bool absorbing = false) {
+    MarchBench& b = marchBench(li, raySamples, absorbing);
     // Photons, cache and (guided) the eq. 17 pre-pass, once per process.
     static std::map<std::string, std::unique_ptr<Marcher>> marchers;
-    auto& marcher = marchers[method + "/" + li + "/" + std::to_string(raySamples)];
+    auto& marcher = marchers[method + "/" + li + "/" + std::to_string(raySamples) + (absorbing ? "/absorbing" : "")];
     if (!marcher)
         marcher = makeMarcher(method, *b.scene,
                               std::make_shared<Illumination>(prepareIllumination(*b.scene, method)));
@@ -316,8 +344,8 @@ void marchSampleBench(benchmark::State& state, const std::string& method, const 
 void BM_GuidedMarchSample(benchmark::State& state, const char* li, int raySamples) {
     marchSampleBench(state, "guided", li, raySamples);
 }
-void BM_TransmittanceMarchSample(benchmark::State& state, const char* li, int raySamples) {
-    marchSampleBench(state, "transmittance", li, raySamples);
+void BM_TransmittanceMarchSample(benchmark::State& state, const char* li, int raySamples, bool absorbing = false) {
+    marchSampleBench(state, "transmittance", li, raySamples, absorbing);
 }
 BENCHMARK_CAPTURE(BM_GuidedMarchSample, li_photons_rs4, "photons", 4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GuidedMarchSample, li_photons_rs1, "photons", 1)->Unit(benchmark::kMillisecond);
@@ -325,6 +353,7 @@ BENCHMARK_CAPTURE(BM_GuidedMarchSample, li_cache_rs4, "cache", 4)->Unit(benchmar
 BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_photons_rs4, "photons", 4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_photons_rs1, "photons", 1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_cache_rs4, "cache", 4)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, walk_only, "photons", 4, true)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -4,6 +4,8 @@
 // one tree lookup per cell crossed (the histogram of section 3.3).
 #pragma once
 
+#include <cmath>
+
 #include "cache/radiance_cache.h"
 #include "cache/sh.h"
 
@@ -23,16 +25,23 @@ public:
     }
 
     // max(0, cached L_i(x, wo)) (eq. 14, clamped); 0 outside every cell.
+    // The last cell is reused when x maps to it by the same arithmetic as
+    // RadianceCache::Query::find, so the value never depends on which points
+    // were looked up before (leaves do not overlap, so that cell is x's).
     float at(const Vec3& x) {
-        if (mCell >= 0 && x.x >= mLo.x && x.x < mHi.x && x.y >= mLo.y && x.y < mHi.y && x.z >= mLo.z && x.z < mHi.z)
-            return mValue;
+        if (mCell >= 0) {
+            const Vec3 q = (x - mCache.origin) / mCache.baseCell;
+            const float s = float(1 << mLevel);
+            if (std::floor(q.x * s) == mI && std::floor(q.y * s) == mJ && std::floor(q.z * s) == mK) return mValue;
+        }
         int64_t c = mQuery.find(x);
         mCell = c;
         if (c < 0) return 0.f;
         const CacheCell& cell = mCache.cells[size_t(c)];
-        const float h = mCache.cellSize(cell.level);
-        mLo = mCache.origin + Vec3(float(cell.i) * h, float(cell.j) * h, float(cell.k) * h);
-        mHi = mLo + Vec3(h, h, h);
+        mLevel = cell.level;
+        mI = float(cell.i);
+        mJ = float(cell.j);
+        mK = float(cell.k);
         mValue = evalShNonNegative(mCache.coefficientCount(), mCache.cellCoefficients(size_t(c)), mY);
         ++mCellsVisited;
         return mValue;
@@ -47,7 +56,8 @@ private:
     Vec3 mWo;
     bool mHaveDirection = false;
     int64_t mCell = -1;
-    Vec3 mLo, mHi;
+    int mLevel = 0;
+    float mI = 0, mJ = 0, mK = 0;  // the cell's coordinates (exact in float below 2^24)
     float mValue = 0;
     size_t mCellsVisited = 0;
 };

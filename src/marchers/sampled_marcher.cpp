@@ -141,7 +141,7 @@ private:
                     int k;
                     float offset;
                     double p;
-                    pdf.sample((double(j) + double(rng.uniform())) / double(n), k, offset, p);
+                    pdf.sample((double(j) + rng.uniformDouble()) / double(n), k, offset, p);
                     const PdfStep& s = steps[size_t(k)];
                     const Vec3 x = ray.at(s.t0 + offset);
                     evalMedia(ctx, region, x, ms);  // the phase mixture at x

@@ -110,11 +110,15 @@ INSTANTIATE_TEST_SUITE_P(Anisotropy, SingleScatteringSlab,
                              return std::get<1>(info.param) + (g == 0 ? "_g0" : (g > 0 ? "_gPlus09" : "_gMinus09"));
                          });
 
-// The same scene and seed give bit-identical pixels for any thread count.
-TEST(Determinism, ImageIsIdenticalForAnyThreadCount) {
+// The same scene and seed give bit-identical pixels for any thread count,
+// for every method (photon tracing and the cache build included: max_depth 3).
+class Determinism : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
     std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
     auto render = [&](int threads) {
-        SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[40,30]", "render.spp=2",
+        SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[40,30]", "render.spp=2", "render.max_depth=3",
+                                                "photons.count=20000", "render.method=\"" + GetParam() + "\"",
                                                 str("render.threads=", threads)});
         return renderImage(*buildScene(d));
     };
@@ -127,6 +131,10 @@ TEST(Determinism, ImageIsIdenticalForAnyThreadCount) {
     for (float v : a.image.rgba) sum += v;
     EXPECT_GT(sum, 0);  // the cloud is lit: not a trivially black image
 }
+
+INSTANTIATE_TEST_SUITE_P(Methods, Determinism,
+                         ::testing::Values(std::string("uniform"), std::string("transmittance"), std::string("guided"),
+                                           std::string("reference")));
 
 // Work grows with active voxels, not with the bounding box: a far-away extra
 // voxel that inflates the bbox 50x leaves the march sample count unchanged.
@@ -159,10 +167,13 @@ namespace vdbmarch::testing {
 namespace {
 
 // A time budget renders whole passes of one sample per pixel; the image is the
-// same, bit for bit, as a render of that many samples per pixel.
-TEST(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
+// same, bit for bit, as a render of that many samples per pixel (for guided,
+// the cache lookups along a ray must not depend on earlier rays).
+class TimeBudget : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
     std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
-    SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]"});
+    SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]", "render.method=\"" + GetParam() + "\""});
     auto scene = buildScene(d);
     RenderOptions timed;
     timed.timeBudget = 0.5;
@@ -173,6 +184,9 @@ TEST(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
     EXPECT_EQ(b.spp, a.spp);
     EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), b.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
 }
+
+INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget,
+                         ::testing::Values(std::string("uniform"), std::string("guided")));
 
 }  // namespace
 }  // namespace vdbmarch::testing
