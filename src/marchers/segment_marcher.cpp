@@ -140,13 +140,21 @@ void SegmentMarcher::applyInfiniteTail(int region, Color& beta) const {
 
 StepTerms stepTerms(const MediumPoint& mp, float dx) {
     StepTerms s;
-    for (int c = 0; c < 3; ++c) {
+    // Grey extinction (the common case): one exp and one expm1, not three each.
+    const int channels = mp.sigma_t[0] == mp.sigma_t[1] && mp.sigma_t[1] == mp.sigma_t[2] ? 1 : 3;
+    for (int c = 0; c < channels; ++c) {
         float kappa = mp.sigma_t[c];
         float tauStep = kappa * dx;
         s.T[c] = std::exp(-tauStep);
         float oneMinusT = tauStep > 1e-4f ? -std::expm1(-tauStep) : tauStep * (1 - 0.5f * tauStep);
         s.absorbedA[c] = kappa > 0 ? oneMinusT * (mp.sigma_a[c] / kappa) : 0.f;
         s.absorbedS[c] = kappa > 0 ? oneMinusT * (mp.sigma_s[c] / kappa) : 0.f;
+        if (channels == 1)
+            for (int d = 1; d < 3; ++d) {
+                s.T[d] = s.T[0];
+                s.absorbedA[d] = kappa > 0 ? oneMinusT * (mp.sigma_a[d] / kappa) : 0.f;
+                s.absorbedS[d] = kappa > 0 ? oneMinusT * (mp.sigma_s[d] / kappa) : 0.f;
+            }
     }
     return s;
 }
