@@ -9,3 +9,15 @@ for s in cloud plume sparse glass; do
   "$ROOT/build/bin/vdbmarch" render "$ROOT/vdb_samples/$s.json" -o "/tmp/vdbmarch_gallery_$s.exr" \
       --png "$OUT/$s.png" --res "$res" --spp "${SPP:-16}"
 done
+
+# The paper's scenes (vdb_samples/scenes), 640x480 with their own method
+# (guided), a PNG next to each scene. TIME seconds per scene, photons and
+# cache included; cloud_sun needs ../shared/assets.
+for s in exp1_point exp1_sphere exp2_collimated fig3b_spots fig4_caustic cloud_sun plume_emission; do
+  if [ "$s" = cloud_sun ] && [ ! -d "$ROOT/../shared/assets" ]; then
+    echo "render_gallery: ../shared/assets is absent: cloud_sun skipped" >&2
+    continue
+  fi
+  "$ROOT/build/bin/vdbmarch" render "$ROOT/vdb_samples/scenes/$s.json" -o "/tmp/vdbmarch_gallery_$s.exr" \
+      --png "$ROOT/vdb_samples/scenes/$s.png" --time "${TIME:-60}"
+done

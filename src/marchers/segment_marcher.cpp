@@ -18,6 +18,10 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
     Color L(0), beta(1);
     Ray ray = cameraRay;
     int region = regionAtRayStart(scene, ray);
+    // After a diffuse bounce, lights and the background were already counted
+    // by the surface's shadow rays, unless glass bent the path since.
+    bool lightsCounted = false;
+    int diffuseBounces = 0;
     for (int bounce = 0;; ++bounce) {
         SurfaceHit h;
         bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
@@ -26,21 +30,38 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
         float segEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
         if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f};
         if (light >= 0) {
-            L += beta * scene.lights[size_t(light)].emittedRadiance();
+            if (!lightsCounted) L += beta * scene.lights[size_t(light)].emittedRadiance();
             return {L, 0.f};
         }
         if (!hit) {
-            L += beta * scene.background;
-            return {L, average(beta)};
+            if (!lightsCounted) L += beta * scene.background;
+            return {L, diffuseBounces > 0 ? 0.f : average(beta)};  // a diffuse surface is opaque
         }
         ++ctx.counters.surfaceHits;
         if (bounce >= scene.desc.render.maxSurfaceBounces) return {L, 0.f};
         const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
         bool entering = dot(ray.d, h.n) < 0;
         switch (s.material.type) {
-            case MaterialDesc::Type::Diffuse:
+            case MaterialDesc::Type::Diffuse: {
                 L += beta * directDiffuse(ctx, region, h.p, h.n, ray.d, s.material.albedo, rng);
-                return {L, 0.f};
+                // Light that reaches the surface after scattering in a medium
+                // (what shadow rays miss): continue the path in a cosine-
+                // sampled direction, marching the media it crosses, as a
+                // scattering event of max_depth. The weight is the albedo.
+                if (++diffuseBounces >= scene.desc.render.maxDepth) return {L, 0.f};
+                beta *= s.material.albedo;
+                const float m = maxComponent(beta);
+                if (m < RouletteThreshold) {
+                    if (rng.uniform() * RouletteThreshold >= m) return {L, 0.f};
+                    beta /= m / RouletteThreshold;
+                }
+                const Vec3 nf = dot(h.n, ray.d) < 0 ? h.n : -h.n;
+                const float u1 = rng.uniform(), u2 = rng.uniform();
+                const Vec3 d = directionAround(nf, std::sqrt(1 - u1), u2);
+                ray = Ray{offsetRayOrigin(scene, h.p, nf, d), d};
+                lightsCounted = true;
+                break;
+            }
             case MaterialDesc::Type::Interface:
                 region = entering ? s.interiorRegion : s.exteriorRegion;
                 ray.o = offsetRayOrigin(scene, h.p, h.n, ray.d);
@@ -67,6 +88,7 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
                     d = reflect ? ray.d + ng * (2 * cosI) : ray.d / eta + ng * (cosI / eta - cosT);
                 }
                 if (!reflect) region = entering ? s.interiorRegion : s.exteriorRegion;
+                if (reflect || s.material.ior != 1.f) lightsCounted = false;  // shadow rays cannot follow this
                 d = normalize(d);
                 ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
                 break;
