@@ -6,9 +6,9 @@
 # Environment: RES (default 80x60), BUDGETS (seconds, default 2,4,8,16).
 #
 # Reference: the transmittance marcher at 1024 samples per pixel (another
-# seed). It has the same expectation as the three methods (the same L_i
-# estimate), so the tables measure what the methods differ in, their noise at
-# equal time. Their common bias against full light transport (the photon
+# pixel seed, the same photon map). It has the same expectation as the three
+# methods (the same L_i estimate, the same photons), so the tables measure
+# what the methods differ in, their sampling noise at equal time. Their common bias against full light transport (the photon
 # map's kNN blur; diffuse surfaces lit directly only) is measured separately
 # against the path tracer where it converges (BENCHMARKS.md); where a delta
 # light is seen through glass (exp1_point, exp2_collimated, fig4_caustic) the
@@ -30,12 +30,19 @@ bench() {  # name scene [bench options...]
       --res "$RES" --strip "$OUT/$name/strip.png" "$@"
 }
 
+# The scene's photon seed (render.seed unless photons.seed is set): the
+# reference shares the methods' photon map, whose noise pattern no number of
+# samples per pixel averages out, and differs only in its pixel samples.
+photonSeed() {
+  python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d.get("photons",{}).get("seed", d.get("render",{}).get("seed",0)))' "$1"
+}
+
 marcherReference() {  # name scene spp: a transmittance image at many samples
   local name=$1 scene=$2 spp=$3
   mkdir -p "$OUT/$name"
   [ -f "$OUT/$name/reference_transmittance.exr" ] ||
     "$V" render "$scene" -o "$OUT/$name/reference_transmittance.exr" --method transmittance --spp "$spp" \
-        --res "$RES" --seed 977 -q
+        --res "$RES" --seed 977 --set "photons.seed=$(photonSeed "$scene")" -q
 }
 
 want() { [ $# -eq 0 ] || [[ " $* " == *" $NAME "* ]]; }

@@ -13,7 +13,7 @@ BakeResult bakeRadianceCache(const Scene& scene, const PhotonSettings& ps, const
         throw InputError(str(scene.desc.file, ": no medium scatters light (every sigma_s is 0 or every density "
                                               "is 0): there is no in-scattered radiance to cache"));
     BakeResult r;
-    PhotonSet set = tracePhotons(scene, size_t(ps.count), scene.desc.render.seed);
+    PhotonSet set = tracePhotons(scene, size_t(ps.count), ps.seedFor(scene.desc.render.seed));
     r.traceSeconds = set.seconds;
     r.paths = set.paths;
     r.directPhotons = set.directCount;
@@ -22,7 +22,7 @@ BakeResult bakeRadianceCache(const Scene& scene, const PhotonSettings& ps, const
     r.treeSeconds = std::chrono::duration<double>(Clock::now() - treeStart).count();
     CacheBuildStats stats;
     r.cache = buildRadianceCache(scene, *r.photons, r.paths, cs, ps.k, &stats);
-    r.cache.info.seed = scene.desc.render.seed;
+    r.cache.info.seed = ps.seedFor(scene.desc.render.seed);
     r.topologySeconds = stats.topologySeconds;
     r.estimateSeconds = stats.estimateSeconds;
     r.photonBytes = r.photons->memoryBytes();

@@ -39,7 +39,7 @@ Illumination prepareIllumination(const Scene& scene, const std::string& method, 
     // which exists only when light may scatter before the last event.
     const bool needIndirect = !il.liFromCache && rs.maxDepth > 1;
     if (needCache || needIndirect) {
-        PhotonSet set = tracePhotons(scene, size_t(scene.desc.photons.count), rs.seed);
+        PhotonSet set = tracePhotons(scene, size_t(scene.desc.photons.count), scene.desc.photons.seedFor(rs.seed));
         il.paths = set.paths;
         il.photons = set.photons.size();
         if (needIndirect && set.directCount < set.photons.size()) {
@@ -55,7 +55,7 @@ Illumination prepareIllumination(const Scene& scene, const std::string& method, 
             PhotonMap all(std::move(set.photons));
             il.cache = std::make_unique<RadianceCache>(
                 buildRadianceCache(scene, all, set.paths, scene.desc.cache, il.k));
-            il.cache->info.seed = rs.seed;
+            il.cache->info.seed = scene.desc.photons.seedFor(rs.seed);
             il.cacheSource = "built";
         }
     }

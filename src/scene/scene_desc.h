@@ -84,6 +84,8 @@ struct RenderSettings {
 struct PhotonSettings {
     int64_t count = 100000;  // photon paths traced
     int k = 50;              // photons per radiance estimate (eq. 4)
+    int64_t seed = -1;       // photon tracing's seed; -1: render.seed
+    uint64_t seedFor(uint64_t renderSeed) const { return seed >= 0 ? uint64_t(seed) : renderSeed; }
 };
 
 // The radiance cache (scene key "cache"; sections 3.1-3.4).

@@ -283,8 +283,14 @@ RenderSettings parseRender(const JsonReader& r) {
 }
 
 PhotonSettings parsePhotons(const JsonReader& r) {
-    r.allowOnly({"count", "k"});
+    r.allowOnly({"count", "k", "seed"});
     PhotonSettings s;
+    if (r.has("seed")) {
+        const Json& v = r.raw("seed");
+        if (!v.is_number_integer() || v.get<long long>() < 0)
+            r.fail("seed", str("must be a non-negative integer, got ", jsonExcerpt(v)));
+        s.seed = v.get<int64_t>();
+    }
     if (r.has("count")) {
         const Json& v = r.raw("count");
         if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > (1LL << 32))

@@ -237,6 +237,20 @@ TEST(RadianceCache, AdaptiveIsMoreAccurateThanUniformAtEqualStorage) {
     }
 }
 
+// photons.seed seeds photon tracing alone: the same cache as render.seed of
+// that value, whatever render.seed is.
+TEST(RadianceCache, PhotonSeedOverridesTheRenderSeed) {
+    std::string a = spotScene(0.7f, false), b = a;
+    a.replace(a.find("\"seed\": 1"), 9, "\"seed\": 9");
+    b.replace(b.find("\"count\": 60000"), 14, "\"count\": 60000, \"seed\": 9");
+    auto sa = sceneFromJson(a), sb = sceneFromJson(b);
+    EXPECT_EQ(sb->desc.photons.seedFor(sb->desc.render.seed), 9u);
+    BakeResult ra = bake(*sa), rb = bake(*sb), r1 = bake(*sceneFromJson(spotScene(0.7f, false)));
+    ASSERT_EQ(ra.cache.coefficients.size(), rb.cache.coefficients.size());
+    EXPECT_EQ(ra.cache.coefficients, rb.cache.coefficients);
+    EXPECT_NE(ra.cache.coefficients, r1.cache.coefficients);
+}
+
 TEST(RadianceCacheFile, RoundTripKeepsEveryCellAndCoefficient) {
     for (bool adaptive : {false, true}) {
         auto scene = sceneFromJson(spotScene(0.7f, adaptive));
