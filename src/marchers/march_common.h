@@ -36,6 +36,7 @@ struct ThreadContext {
     // and sum each segment's throughput times its histogram integral.
     bool measureOnly = false;
     double measuredGuided = 0;
+    size_t measuredSegments = 0;  // segments through scattering media
 };
 
 // Coefficients of all media of a region at one point. Each medium's

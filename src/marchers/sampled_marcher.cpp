@@ -23,7 +23,8 @@
 //
 // Guided allots N per segment by eq. 17: proportional to the segment's
 // expected in-scattering sum(h sigma_s T S) times the path throughput,
-// relative to its mean over the image (a pre-pass of camera rays), between
+// relative to its mean over the segments through media (a pre-pass of
+// camera rays), between
 // render.ray_samples / 4 and 8 render.ray_samples; transmittance always takes
 // render.ray_samples. Emission is integrated on the steps, as uniform does.
 #include <algorithm>
@@ -47,8 +48,9 @@ public:
     }
 
 private:
-    // Eq. 17's scale: the mean over a grid of pixel-centre camera rays of
-    // their histogram integrals. Deterministic (fixed ray seeds).
+    // Eq. 17's scale: the mean histogram integral of the camera-ray segments
+    // through scattering media, over a grid of pixel-centre camera rays.
+    // Deterministic (fixed ray seeds).
     double measureMeanGuided() const {
         ThreadContext ctx(mScene);
         ctx.measureOnly = true;
@@ -59,7 +61,10 @@ private:
                 float x = (float(i) + 0.5f) * float(w) / PrepassWidth, y = (float(j) + 0.5f) * float(h) / PrepassHeight;
                 radiance(mScene.camera->generateRay(x, y), rng, ctx);
             }
-        return ctx.measuredGuided / (PrepassWidth * PrepassHeight);
+        // Per segment through a scattering medium, not per camera ray: rays
+        // that miss the media take no samples, so the mean N over the
+        // segments that do stays render.ray_samples, as for transmittance.
+        return ctx.measuredSegments > 0 ? ctx.measuredGuided / double(ctx.measuredSegments) : 0.0;
     }
 
     int sampleCount(const RayPdf& pdf, const Color& beta) const {
@@ -132,6 +137,7 @@ private:
             RayPdf& pdf = ctx.rayPdf;
             pdf.build(steps, cache ? ctx.stepH.data() : nullptr);
             if (ctx.measureOnly) {
+                if (pdf.valid()) ++ctx.measuredSegments;
                 ctx.measuredGuided += double(average(beta)) * pdf.guidedIntegral();
             } else if (pdf.valid()) {
                 // N stratified positions (one uniform per stratum of the CDF).
