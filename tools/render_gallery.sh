@@ -20,4 +20,8 @@ for s in exp1_point exp1_sphere exp2_collimated fig3b_spots fig4_caustic cloud_s
   fi
   "$ROOT/build/bin/vdbmarch" render "$ROOT/vdb_samples/scenes/$s.json" -o "/tmp/vdbmarch_gallery_$s.exr" \
       --png "$ROOT/vdb_samples/scenes/$s.png" --time "${TIME:-60}"
+  # A 256-colour palette keeps the committed PNG small (noise compresses badly).
+  if command -v convert >/dev/null; then
+    convert "$ROOT/vdb_samples/scenes/$s.png" -colors 256 "PNG8:$ROOT/vdb_samples/scenes/$s.png"
+  fi
 done
