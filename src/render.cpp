@@ -74,14 +74,14 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // Photons and the cache count in the time budget: an equal-time
     // comparison charges the guided marcher for its cache.
     std::shared_ptr<Illumination> illumination;
+    std::unique_ptr<Marcher> marcher;
     arena.execute([&] {
         illumination = std::make_shared<Illumination>(prepareIllumination(scene, rs.method, options.illumination));
+        marcher = makeMarcher(rs.method, scene, illumination);
     });
     result.illuminationSeconds = illumination->seconds;
     result.photons = illumination->photons;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
-    std::unique_ptr<Marcher> marcher;
-    arena.execute([&] { marcher = makeMarcher(rs.method, scene, illumination); });
 
     // One pass renders samples [s0, s1) of every pixel. Each pixel sums its
     // samples in index order, so the image depends only on the final sample

@@ -43,11 +43,8 @@ public:
         mJ = float(cell.j);
         mK = float(cell.k);
         mValue = evalShNonNegative(mCache.coefficientCount(), mCache.cellCoefficients(size_t(c)), mY);
-        ++mCellsVisited;
         return mValue;
     }
-
-    size_t cellsVisited() const { return mCellsVisited; }
 
 private:
     const RadianceCache& mCache;
@@ -59,7 +56,6 @@ private:
     int mLevel = 0;
     float mI = 0, mJ = 0, mK = 0;  // the cell's coordinates (exact in float below 2^24)
     float mValue = 0;
-    size_t mCellsVisited = 0;
 };
 
 }  // namespace vdbmarch

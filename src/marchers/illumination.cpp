@@ -32,7 +32,6 @@ Illumination prepareIllumination(const Scene& scene, const std::string& method, 
         RadianceCache c = RadianceCache::load(options.cacheFile);
         checkCacheMatchesScene(c, scene, options.cacheFile, options.force);
         il.cache = std::make_unique<RadianceCache>(std::move(c));
-        il.cacheSource = options.cacheFile;
         needCache = false;
     }
     // Shadow rays compute the direct light; the photon map adds the rest,
@@ -40,7 +39,6 @@ Illumination prepareIllumination(const Scene& scene, const std::string& method, 
     const bool needIndirect = !il.liFromCache && rs.maxDepth > 1;
     if (needCache || needIndirect) {
         PhotonSet set = tracePhotons(scene, size_t(scene.desc.photons.count), scene.desc.photons.seedFor(rs.seed));
-        il.paths = set.paths;
         il.photons = set.photons.size();
         if (needIndirect && set.directCount < set.photons.size()) {
             std::vector<Photon> indirect;
@@ -56,7 +54,6 @@ Illumination prepareIllumination(const Scene& scene, const std::string& method, 
             il.cache = std::make_unique<RadianceCache>(
                 buildRadianceCache(scene, all, set.paths, scene.desc.cache, il.k));
             il.cache->info.seed = scene.desc.photons.seedFor(rs.seed);
-            il.cacheSource = "built";
         }
     }
     il.seconds = std::chrono::duration<double>(Clock::now() - start).count();

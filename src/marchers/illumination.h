@@ -19,9 +19,8 @@ struct Illumination {
     std::unique_ptr<RadianceCache> cache;  // null unless the method or render.li needs it
     int k = 50;                            // photons per estimate
     bool liFromCache = false;              // render.li = "cache"
-    size_t paths = 0, photons = 0;
+    size_t photons = 0;                    // photons stored (statistics)
     double seconds = 0;                    // photon tracing, kd-trees and cache build
-    std::string cacheSource;               // "built" or the file it was loaded from
 };
 
 struct IlluminationOptions {

@@ -35,8 +35,6 @@ public:
 
     // False when no step can scatter (sum of base is 0): nothing to sample.
     bool valid() const { return mBase > 0; }
-    // sum(base): the integral of T sigma_s (eq. 11's S sigma summed).
-    double baseIntegral() const { return mBase; }
     // sum(base h): the histogram's estimate of the segment's in-scattering,
     // S_h sigma of eq. 17 (0 without a cache).
     double guidedIntegral() const { return mGuided; }
