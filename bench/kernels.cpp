@@ -13,12 +13,13 @@
 #include "cache/sh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
-#include "marchers/illumination.h"
-#include "marchers/march_common.h"
+#include "illumination/illumination.h"
+#include "transport/media_point.h"
+#include "transport/roulette.h"
 #include "marchers/marcher.h"
 #include "marchers/segment_marcher.h"
 #include "scene/scene.h"
-#include "scene/scene_desc.h"
+#include "parse/scene_desc.h"
 #include "volume/medium.h"
 
 using namespace vdbmarch;
@@ -329,9 +330,11 @@ void marchSampleBench(benchmark::State& state, const std::string& method, const 
     // Photons, cache and (guided) the eq. 17 pre-pass, once per process.
     static std::map<std::string, std::unique_ptr<Marcher>> marchers;
     auto& marcher = marchers[method + "/" + li + "/" + std::to_string(raySamples) + (absorbing ? "/absorbing" : "")];
-    if (!marcher)
-        marcher = makeMarcher(method, *b.scene,
-                              std::make_shared<Illumination>(prepareIllumination(*b.scene, method)));
+    if (!marcher) {
+        Method m = Method::Uniform;
+        parseMethod(method, m);
+        marcher = makeMarcher(m, *b.scene, std::make_shared<Illumination>(prepareIllumination(*b.scene, m)));
+    }
     ThreadContext ctx(*b.scene);
     for (auto _ : state) {
         for (size_t i = 0; i < b.rays.size(); ++i) {

@@ -17,15 +17,15 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
 #include "image/png_io.h"
-#include "bench.h"
-#include "cache/bake.h"
+#include "app/bench.h"
+#include "illumination/bake.h"
 #include "cache/cache_inspect.h"
 #include "marchers/marcher.h"
-#include "render.h"
+#include "render/render.h"
 #include "scene/auto_scene.h"
 #include "scene/scene.h"
 #include "volume/medium.h"
@@ -124,17 +124,17 @@ int runRender(const RenderArgs& a) {
     StringAttributes attrs = {
         {"vdbmarch:version", VDBMARCH_VERSION},
         {"vdbmarch:source", desc.file},
-        {"vdbmarch:method", desc.render.method},
+        {"vdbmarch:method", methodName(desc.render.method)},
         {"vdbmarch:spp", std::to_string(r.spp)},
         {"vdbmarch:timeBudget", a.timeSet ? str(a.timeBudget) : std::string("none")},
         {"vdbmarch:seed", std::to_string(desc.render.seed)},
         {"vdbmarch:step", str(scene->step)},
         {"vdbmarch:shadowStep", str(scene->shadowStep)},
         {"vdbmarch:renderSeconds", str(r.seconds)},
-        {"vdbmarch:scene", desc.json.dump()},
+        {"vdbmarch:scene", desc.jsonText},
     };
     writeExr(a.output, r.image, attrs);
-    if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, desc.json.dump(2) + "\n");
+    if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
     if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) {
@@ -144,7 +144,7 @@ int runRender(const RenderArgs& a) {
         s["photons"] = r.photons;
         s["cache_cells"] = r.cacheCells;
         s["threads"] = r.threads;
-        s["method"] = desc.render.method;
+        s["method"] = methodName(desc.render.method);
         s["spp"] = r.spp;
         if (a.timeSet) s["time_budget"] = a.timeBudget;
         s["resolution"] = {r.image.width, r.image.height};
@@ -159,7 +159,7 @@ int runRender(const RenderArgs& a) {
     }
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
-                     r.image.width, r.image.height, r.spp, desc.render.method.c_str(), double(scene->step),
+                     r.image.width, r.image.height, r.spp, methodName(desc.render.method), double(scene->step),
                      r.seconds,
                      r.illuminationSeconds > 0
                          ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s, ").c_str()
@@ -203,8 +203,8 @@ int runBenchCommand(const BenchArgs& a) {
     BenchOptions o;
     o.methods = splitList(a.methods);
     for (const auto& m : o.methods) {
-        auto names = marcherNames();
-        if (m != "vdb_render" && std::find(names.begin(), names.end(), m) == names.end())
+        Method known;
+        if (m != "vdb_render" && !parseMethod(m, known))
             throw InputError(str("--methods: unknown method \"", m, "\""));
     }
     for (const auto& b : splitList(a.budgets)) {
@@ -368,8 +368,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
 
     RenderArgs ra;
-    std::string methods;
-    for (const auto& m : marcherNames()) methods += (methods.empty() ? "" : ", ") + m;
+    const std::string methods = methodList();
     CLI::App* render = app.add_subcommand("render", "Render a JSON scene or a bare .vdb file to EXR (and PNG)");
     render->add_option("input", ra.input, "Scene .json, or a .vdb to render with automatic camera and lights")->required();
     render->add_option("-o,--output", ra.output, "Output image (.exr, float RGBA, alpha = 1 - transmittance)")->required();

@@ -7,8 +7,12 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include "cache/sh.h"
 #include "photons/photon_tracer.h"
+#include "transport/media_point.h"
+#include "transport/surface_event.h"
 
 namespace vdbmarch {
 
@@ -126,25 +130,6 @@ int effectiveShOrder(const Scene& scene, int requested) {
     return 0;
 }
 
-std::string sceneHash(const SceneDesc& desc) {
-    nlohmann::json j = desc.json;
-    j.erase("camera");
-    j.erase("photons");
-    j.erase("cache");
-    int maxDepth = desc.render.maxDepth;
-    j.erase("render");
-    j["max_depth"] = maxDepth;
-    std::string s = j.dump();
-    uint64_t h = 1469598103934665603ULL;  // FNV-1a
-    for (unsigned char c : s) {
-        h ^= c;
-        h *= 1099511628211ULL;
-    }
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-    return buf;
-}
-
 RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_t paths,
                                  const CacheSettings& settings, int kNearest, CacheBuildStats* stats) {
     auto start = Clock::now();
@@ -239,20 +224,33 @@ RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_
     }
     double topologySeconds = secondsSince(start);
 
-    // Eq. 27 at every cell centre from its k nearest photons, each photon
-    // with the Legendre weights w'_l = g^l of the phase where it landed.
+    // Eq. 27 at every cell centre from its k nearest photons, with the
+    // Legendre weights of the phase mixture at the centre (eq. 26: sum_i
+    // w_i g_i^l where media overlap), as eq. 4 takes the phase at the point
+    // it estimates. A centre where nothing scatters (a cell across a
+    // medium's edge) takes each photon's own mean g^l.
     auto estimateStart = Clock::now();
     const int order = cache.info.shOrder, count = cache.coefficientCount();
     const size_t kk = size_t(std::min(kNearest, 1024));
     cache.coefficients.assign(cache.cells.size() * size_t(count), 0.f);
+    tbb::enumerable_thread_specific<ThreadContext> contexts([&] { return ThreadContext(scene); });
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cache.cells.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        ThreadContext& ctx = contexts.local();
         std::vector<uint32_t> idx(kk);
         std::vector<float> d2(kk);
         float Y[shCount(MaxShOrder)], w[MaxShOrder + 1];
+        MediumPoint mp;
         for (size_t c = r.begin(); c < r.end(); ++c) {
-            size_t n = map.nearest(cache.cellCenter(cache.cells[c]), kk, idx.data(), d2.data());
+            const Vec3 x = cache.cellCenter(cache.cells[c]);
+            size_t n = map.nearest(x, kk, idx.data(), d2.data());
             if (n == 0 || !(d2[n - 1] > 0)) continue;
             float* f = &cache.coefficients[c * size_t(count)];
+            bool centreScatters = false;
+            if (order > 0) {
+                evalMedia(ctx, regionAtRayStart(scene, Ray{x, Vec3(0, 0, 1)}), x, mp);
+                centreScatters = mp.scatters();
+                if (centreScatters) mp.phase.legendreWeights(order, w);
+            }
             for (size_t i = 0; i + 1 < n; ++i) {  // the farthest only sets the radius
                 const Photon& p = map[idx[i]];
                 float weight = average(p.weight);
@@ -261,7 +259,7 @@ RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_
                     continue;
                 }
                 evalSh(order, p.travelDirection(), Y);
-                hgLegendreWeights(order, p.g(), w);
+                if (!centreScatters) hgLegendreWeights(order, p.g(), w);
                 for (int l = 0; l <= order; ++l)
                     for (int m = -l; m <= l; ++m) f[shIndex(l, m)] += weight * w[l] * Y[shIndex(l, m)];
             }

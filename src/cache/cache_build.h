@@ -28,9 +28,5 @@ int effectiveShOrder(const Scene& scene, int requested);
 RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& photons, size_t paths,
                                  const CacheSettings& settings, int k, CacheBuildStats* stats = nullptr);
 
-// Hash of everything in the scene that changes the light field (media,
-// lights, surfaces, background, max_depth) but not the camera or render
-// settings: a cache baked for one scene is refused for another.
-std::string sceneHash(const SceneDesc& desc);
 
 }  // namespace vdbmarch

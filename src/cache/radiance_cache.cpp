@@ -11,8 +11,9 @@
 #include <openvdb/openvdb.h>
 
 #include "cache/sh.h"
+#include "core/hash.h"
 #include "core/error.h"
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace vdbmarch {
 
@@ -43,15 +44,6 @@ T metaValue(const openvdb::GridBase& g, const std::string& key, const std::strin
 const std::string ChecksumTag = "\nvdbmarch-fnv1a64:";
 constexpr size_t ChecksumDigits = 16;
 
-uint64_t fnv1a(const char* data, size_t n) {
-    uint64_t h = 1469598103934665603ULL;
-    for (size_t i = 0; i < n; ++i) {
-        h ^= static_cast<unsigned char>(data[i]);
-        h *= 1099511628211ULL;
-    }
-    return h;
-}
-
 std::string hex64(uint64_t v) {
     char buf[17];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
@@ -63,7 +55,7 @@ void appendChecksum(const std::string& path) {
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (!in.eof() && in.fail()) throw IoError(str(path, ": cannot read back the cache to checksum it"));
     std::ofstream out(path, std::ios::binary | std::ios::app);
-    out << ChecksumTag << hex64(fnv1a(bytes.data(), bytes.size()));
+    out << ChecksumTag << hex64(fnv1a64(bytes.data(), bytes.size()));
     if (!out.flush()) throw IoError(str(path, ": cannot write the cache checksum: ", std::strerror(errno)));
 }
 
@@ -76,7 +68,7 @@ bool verifyChecksum(const std::string& path) {
     if (bytes.size() < trailer || bytes.compare(bytes.size() - trailer, ChecksumTag.size(), ChecksumTag) != 0)
         return false;
     std::string stored = bytes.substr(bytes.size() - ChecksumDigits);
-    if (stored != hex64(fnv1a(bytes.data(), bytes.size() - trailer)))
+    if (stored != hex64(fnv1a64(bytes.data(), bytes.size() - trailer)))
         throw InputError(str(path, ": checksum mismatch: the cache file is damaged; bake it again"));
     return true;
 }

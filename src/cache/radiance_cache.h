@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/math.h"
-#include "scene/scene_desc.h"
+#include "parse/scene_desc.h"
 
 namespace vdbmarch {
 

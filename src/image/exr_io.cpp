@@ -1,7 +1,7 @@
 #include "image/exr_io.h"
 
 #include "core/error.h"
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 
 #include <OpenEXR/Iex.h>
 #include <OpenEXR/ImfChannelList.h>

@@ -4,7 +4,7 @@
 #include "image/png_io.h"
 
 #include "core/error.h"
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 
 #include <png.h>
 

@@ -1,40 +1,37 @@
 #include "marchers/marcher.h"
 
 #include "core/error.h"
-#include "marchers/illumination.h"
+#include "illumination/illumination.h"
 
 namespace vdbmarch {
 
 namespace {
 struct Entry {
-    const char* name;
+    Method method;
     std::unique_ptr<Marcher> (*make)(const Scene&, std::shared_ptr<const Illumination>);
 };
 // The factory table: one line per method.
 const Entry kMarchers[] = {
-    {"uniform", makeUniformMarcher},
-    {"transmittance", makeTransmittanceMarcher},
-    {"guided", makeGuidedMarcher},
-    {"reference", makeReferenceTracer},
+    {Method::Uniform, makeUniformMarcher},
+    {Method::Transmittance, makeTransmittanceMarcher},
+    {Method::Guided, makeGuidedMarcher},
+    {Method::Reference, makeReferenceTracer},
 };
 }  // namespace
 
-std::vector<std::string> marcherNames() {
-    std::vector<std::string> names;
-    for (const auto& e : kMarchers) names.push_back(e.name);
-    return names;
+std::vector<Method> marcherMethods() {
+    std::vector<Method> methods;
+    for (const auto& e : kMarchers) methods.push_back(e.method);
+    return methods;
 }
 
-std::unique_ptr<Marcher> makeMarcher(const std::string& method, const Scene& scene,
-                                     std::shared_ptr<const Illumination> illumination) {
+std::unique_ptr<Marcher> makeMarcher(Method method, const Scene& scene, std::shared_ptr<const Illumination> illumination) {
     for (const auto& e : kMarchers)
-        if (method == e.name) {
+        if (method == e.method) {
             if (!illumination) illumination = std::make_shared<Illumination>(prepareIllumination(scene, method));
             return e.make(scene, std::move(illumination));
         }
-    std::string known;
-    for (const auto& e : kMarchers) known += str(" ", e.name);
-    throw InputError(str("unknown method \"", method, "\"; this build implements:", known));
+    throw std::logic_error(str("no marcher for method ", methodName(method)));
 }
 
 }  // namespace vdbmarch

@@ -8,7 +8,8 @@
 
 #include "core/math.h"
 #include "core/rng.h"
-#include "marchers/march_common.h"
+#include "parse/method.h"
+#include "transport/thread_context.h"
 
 namespace vdbmarch {
 
@@ -26,12 +27,12 @@ public:
     virtual PathResult radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const = 0;
 };
 
-// Methods this build implements, in the order `--method` lists them.
-std::vector<std::string> marcherNames();
-// Throws InputError for an unknown name, listing the known ones. The
-// marchers estimate L_i from `illumination` (photon map, cache); when null it
-// is prepared here from the scene (prepareIllumination).
-std::unique_ptr<Marcher> makeMarcher(const std::string& method, const Scene& scene,
+// Methods the factory table implements, in the order `--method` lists them
+// (every Method: a test checks it). Method-parameterised tests run over it.
+std::vector<Method> marcherMethods();
+// The marchers estimate L_i from `illumination` (photon map, cache); when
+// null it is prepared here from the scene (prepareIllumination).
+std::unique_ptr<Marcher> makeMarcher(Method method, const Scene& scene,
                                      std::shared_ptr<const Illumination> illumination = nullptr);
 
 // Constructors behind the factory table.

@@ -18,16 +18,15 @@
 
 #include "core/sampling.h"
 #include "marchers/marcher.h"
-#include "scene/scene.h"
+#include "transport/direct_light.h"
+#include "transport/media_point.h"
+#include "transport/roulette.h"
+#include "transport/surface_event.h"
+#include "transport/tracking.h"
 
 namespace vdbmarch {
 
 namespace {
-
-float powerHeuristic(float a, float b) {
-    float a2 = a * a, b2 = b * b;
-    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;
-}
 
 class ReferenceTracer final : public Marcher {
 public:
@@ -51,106 +50,6 @@ public:
     }
 
 private:
-    // Ratio-tracking transmittance along a shadow ray through the region's
-    // media over [0, dist); constant media exactly. Crosses interfaces,
-    // stops at any other surface or a sphere light.
-    Color transmittance(ThreadContext& ctx, int region, Ray r, float dist, Rng& rng) const {
-        ++ctx.counters.shadowRays;
-        Color T(1);
-        bool reached = walkShadowRay(mScene, region, r, dist, [&](int reg, const Ray& seg, float tEnd) {
-            T *= segmentTransmittance(ctx, reg, seg, tEnd, rng);
-            return !isBlack(T);
-        });
-        return reached ? T : Color(0);
-    }
-
-    Color segmentTransmittance(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng) const {
-        Color T(1);
-        const auto& media = mScene.regions[size_t(region)].media;
-        if (media.empty()) return T;
-        // Constant media: exact. Gridded media: ratio tracking with their
-        // local majorants (max over channels, so weights stay in [0, 1]).
-        for (int mi : media) {
-            const Medium& m = *mScene.media[size_t(mi)];
-            const Color k = m.sigma_a + m.sigma_s;
-            MediumQuery& q = *ctx.queries[size_t(mi)];
-            float integral;
-            if (q.densityIntegral(r, 0.f, tEnd, integral)) {
-                for (int c = 0; c < 3; ++c)
-                    if (integral > 0 && k[c] > 0) T[c] *= std::exp(-k[c] * integral);
-                continue;
-            }
-            float kMax = maxComponent(k);
-            if (!(kMax > 0)) continue;
-            ctx.scratchSegments.clear();
-            mediumMajorants(ctx, mi, r, tEnd, ctx.scratchSegments);
-            for (const auto& seg : ctx.scratchSegments) {
-                float sigmaMaj = seg.maxDensity * kMax;
-                if (!(sigmaMaj > 0)) continue;
-                double t = seg.t0;
-                while (true) {
-                    t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
-                    if (t >= seg.t1) break;
-                    ++ctx.counters.shadowSamples;
-                    float d = q.density(r.at(t));
-                    for (int c = 0; c < 3; ++c) T[c] *= std::max(0.f, 1 - k[c] * d / sigmaMaj);
-                    if (maxComponent(T) < 1e-3f) {  // Russian roulette keeps it unbiased
-                        float qq = maxComponent(T) / 1e-3f;
-                        if (rng.uniform() >= qq) return Color(0);
-                        T /= qq;
-                    }
-                }
-            }
-        }
-        return T;
-    }
-
-    // Direct light at a medium scattering point (phase) or a diffuse surface
-    // point (albedo cos / pi), with MIS for sphere lights.
-    Color nextEvent(ThreadContext& ctx, int region, const Vec3& p, const Vec3& d, const MediumPoint* mp,
-                    const Vec3* n, const Color& albedo, Rng& rng) const {
-        Color Ld(0);
-        for (size_t li = 0; li < mScene.lights.size(); ++li) {
-            const Light& light = mScene.lights[li];
-            LightSample ls;
-            float u1 = rng.uniform(), u2 = rng.uniform();
-            Vec3 origin = p;
-            if (n) {  // leave the surface on the side the path arrived from
-                Vec3 nf = dot(*n, d) < 0 ? *n : -*n;
-                origin = p + nf * (1e-5f * std::max(mScene.sceneScale, maxComponent(max(p, -p))));
-            }
-            if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;
-            Color f;
-            float scatterPdf;
-            if (mp) {
-                float ph = hgMix(*mp, dot(ls.wi, d));
-                f = phaseMixture(*mp, dot(ls.wi, d));
-                scatterPdf = ph;
-            } else {
-                Vec3 nf = dot(*n, d) < 0 ? *n : -*n;
-                float c = dot(ls.wi, nf);
-                if (c <= 0) continue;
-                f = albedo * (c * InvPi);
-                scatterPdf = c * InvPi;
-            }
-            if (isBlack(f)) continue;
-            float w = 1;
-            if (light.isSphere()) w = powerHeuristic(ls.pdf, scatterPdf);
-            Color T = transmittance(ctx, region, Ray{origin, ls.wi}, ls.dist, rng);
-            Ld += f * ls.L * T * w;
-        }
-        return Ld;
-    }
-
-    // pdf of the phase mixture used for sampling (mixture weights by sigma_s).
-    static float hgMix(const MediumPoint& mp, float cosTheta) {
-        if (mp.count == 1) return hgPhase(cosTheta, mp.g[0]);
-        float total = 0, pdf = 0;
-        for (int i = 0; i < mp.count; ++i) total += average(mp.sigmaS[i]);
-        for (int i = 0; i < mp.count; ++i) pdf += average(mp.sigmaS[i]) / total * hgPhase(cosTheta, mp.g[i]);
-        return pdf;
-    }
-
     PathResult trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx, int channel) const {
         const Scene& scene = mScene;
         const int maxDepth = scene.desc.render.maxDepth;
@@ -191,9 +90,10 @@ private:
                     beta = Color(0);
                     return false;
                 }
-                L += beta * nextEvent(ctx, region, x, ray.d, &mp, nullptr, Color(0), rng);
+                L += beta * directLight(ctx, region, ScatterVertex{x, ray.d, &mp.phase}, rng, kNextEvent);
                 float pdf;
-                Vec3 wi = samplePhaseMixture(mp, ray.d, rng, beta, pdf);
+                const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+                Vec3 wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
                 lastPdf = pdf;
                 specular = false;
                 lastPoint = x;
@@ -226,35 +126,23 @@ private:
             }
             ++ctx.counters.surfaceHits;
             if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return {channelOnly(L, channel), 0.f};
-            const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
-            bool entering = dot(ray.d, h.n) < 0;
-            if (s.material.type == MaterialDesc::Type::Interface) {
-                region = entering ? s.interiorRegion : s.exteriorRegion;
-                ray.o = offsetRayOrigin(scene, h.p, h.n, ray.d);
-                continue;
-            }
-            if (s.material.type == MaterialDesc::Type::Diffuse) {
+            const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
+            const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
+            if (e.kind == SurfaceEvent::Kind::Diffuse) {
                 ++depth;
                 if (depth > maxDepth) return {channelOnly(L, channel), 0.f};
-                Vec3 nf = entering ? h.n : -h.n;
-                L += beta * nextEvent(ctx, region, h.p, ray.d, nullptr, &h.n, s.material.albedo, rng);
-                float u1 = rng.uniform(), u2 = rng.uniform();
-                float cosT = std::sqrt(1 - u1);
-                Vec3 wi = directionAround(nf, cosT, u2);
-                beta *= s.material.albedo;  // f cos / pdf = albedo
-                lastPdf = cosT * InvPi;
+                const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
+                L += beta * directLight(ctx, region, ScatterVertex{h.p, ray.d, nullptr, h.n, albedo}, rng, kNextEvent);
+                lastPdf = e.pdf;
                 specular = false;
                 lastPoint = h.p;
-                ray = Ray{offsetRayOrigin(scene, h.p, h.n, wi), wi};
-                if (!roulette(beta, depth, rng)) return {channelOnly(L, channel), 0.f};
-                continue;
+            } else if (!e.straight) {
+                specular = true;  // next-event estimation cannot see through this
             }
-            // Dielectric: Fresnel choice; the weights cancel.
-            bool refracted;
-            Vec3 d = sampleDielectric(ray.d, h.n, s.material.ior, rng.uniform(), refracted);
-            if (refracted) region = entering ? s.interiorRegion : s.exteriorRegion;
-            specular = true;
-            ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
+            beta *= e.weight;
+            ray = e.ray;
+            region = e.region;
+            if (e.kind == SurfaceEvent::Kind::Diffuse && !roulette(beta, depth, rng)) return {channelOnly(L, channel), 0.f};
         }
     }
 
@@ -270,14 +158,14 @@ private:
         return out;
     }
 
-    // Unbiased Russian roulette after three scattering events.
+    // Russian roulette on the throughput after RouletteMinDepth events.
     static bool roulette(Color& beta, int depth, Rng& rng) {
-        if (depth < 3) return true;
-        float q = std::min(0.95f, maxComponent(beta));
-        if (!(q > 0) || rng.uniform() >= q) return false;
-        beta /= q;
-        return true;
+        return depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold);
     }
+
+    // Next-event estimation: ratio tracking; sphere lights are also hit by
+    // the path, the background only by the path.
+    static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
 
     const Scene& mScene;
     bool mChromatic = false;

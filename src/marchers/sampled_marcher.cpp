@@ -31,6 +31,7 @@
 #include <cmath>
 
 #include "marchers/segment_marcher.h"
+#include "transport/roulette.h"
 
 namespace vdbmarch {
 
@@ -53,7 +54,8 @@ private:
     // Deterministic (fixed ray seeds).
     double measureMeanGuided() const {
         ThreadContext ctx(mScene);
-        ctx.measureOnly = true;
+        MarcherScratch& m = scratch(ctx);
+        m.measureOnly = true;
         const int w = mScene.camera->width(), h = mScene.camera->height();
         for (int j = 0; j < PrepassHeight; ++j)
             for (int i = 0; i < PrepassWidth; ++i) {
@@ -64,7 +66,7 @@ private:
         // Per segment through a scattering medium, not per camera ray: rays
         // that miss the media take no samples, so the mean N over the
         // segments that do stays render.ray_samples, as for transmittance.
-        return ctx.measuredSegments > 0 ? ctx.measuredGuided / double(ctx.measuredSegments) : 0.0;
+        return m.measuredSegments > 0 ? m.measuredGuided / double(m.measuredSegments) : 0.0;
     }
 
     int sampleCount(const RayPdf& pdf, const Color& beta) const {
@@ -80,12 +82,13 @@ private:
         const Scene& scene = mScene;
         bool infiniteTail;
         if (!activeIntervals(ctx, region, ray, tEnd, infiniteTail)) return true;
-        auto& steps = ctx.pdfSteps;
+        MarcherScratch& m = scratch(ctx);
+        auto& steps = m.pdfSteps;
         steps.clear();
-        ctx.stepSigmaS.clear();
-        ctx.stepKappa.clear();
-        ctx.stepT.clear();
-        ctx.stepH.clear();
+        m.stepSigmaS.clear();
+        m.stepKappa.clear();
+        m.stepT.clear();
+        m.stepH.clear();
         CacheLookup* cache = mGuided ? &cacheLookup(ctx) : nullptr;
         if (cache) cache->setDirection(-ray.d);
 
@@ -109,20 +112,19 @@ private:
                 const StepTerms st = stepTerms(mp, len);
                 L += beta * T * st.absorbedA * mp.emission;
                 const float base = average(T * st.absorbedS);  // sigma_s T(t0) S(kappa, len)
-                if (mp.count > 0 && base > 0) {
+                if (mp.scatters() && base > 0) {
                     steps.push_back({float(a), len, average(mp.sigma_t), base});
-                    ctx.stepSigmaS.push_back(mp.sigma_s);
-                    ctx.stepKappa.push_back(mp.sigma_t);
-                    ctx.stepT.push_back(T);
-                    if (cache) ctx.stepH.push_back(cache->at(x));
+                    m.stepSigmaS.push_back(mp.sigma_s);
+                    m.stepKappa.push_back(mp.sigma_t);
+                    m.stepT.push_back(T);
+                    if (cache) m.stepH.push_back(cache->at(x));
                 }
                 T *= st.T;
-                const float m = maxComponent(beta * T);
-                if (m < RouletteThreshold) {
-                    // Russian roulette on the rest of the segment; the steps
-                    // already taken keep their weights, later ones carry 1/q.
-                    const float q = m / RouletteThreshold;
-                    if (rng.uniform() >= q) {
+                // Russian roulette on the rest of the segment; the steps
+                // already taken keep their weights, later ones carry 1/q.
+                const float q = rouletteSurvival(beta * T);
+                if (q < 1) {
+                    if (!(q > 0) || rng.uniform() >= q) {
                         T = Color(0);
                         ended = true;
                     } else {
@@ -134,11 +136,11 @@ private:
         }
 
         if (!steps.empty()) {
-            RayPdf& pdf = ctx.rayPdf;
-            pdf.build(steps, cache ? ctx.stepH.data() : nullptr);
-            if (ctx.measureOnly) {
-                if (pdf.valid()) ++ctx.measuredSegments;
-                ctx.measuredGuided += double(average(beta)) * pdf.guidedIntegral();
+            RayPdf& pdf = m.rayPdf;
+            pdf.build(steps, cache ? m.stepH.data() : nullptr);
+            if (m.measureOnly) {
+                if (pdf.valid()) ++m.measuredSegments;
+                m.measuredGuided += double(average(beta)) * pdf.guidedIntegral();
             } else if (pdf.valid()) {
                 // N stratified positions (one uniform per stratum of the CDF).
                 const int n = sampleCount(pdf, beta);
@@ -153,9 +155,9 @@ private:
                     evalMedia(ctx, region, x, ms);  // the phase mixture at x
                     const Color Li = inScattered(ctx, region, x, ray.d, ms, rng);
                     if (isBlack(Li)) continue;
-                    Color Tt = ctx.stepT[size_t(k)];
-                    for (int c = 0; c < 3; ++c) Tt[c] *= std::exp(-ctx.stepKappa[size_t(k)][c] * offset);
-                    L += beta * Tt * ctx.stepSigmaS[size_t(k)] * Li * float(1.0 / (double(n) * p));
+                    Color Tt = m.stepT[size_t(k)];
+                    for (int c = 0; c < 3; ++c) Tt[c] *= std::exp(-m.stepKappa[size_t(k)][c] * offset);
+                    L += beta * Tt * m.stepSigmaS[size_t(k)] * Li * float(1.0 / (double(n) * p));
                 }
             }
         }

@@ -3,7 +3,9 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "core/sampling.h"
+#include "transport/direct_light.h"
+#include "transport/roulette.h"
+#include "transport/surface_event.h"
 
 namespace vdbmarch {
 
@@ -39,83 +41,49 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
         }
         ++ctx.counters.surfaceHits;
         if (bounce >= scene.desc.render.maxSurfaceBounces) return {L, 0.f};
-        const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
-        bool entering = dot(ray.d, h.n) < 0;
-        switch (s.material.type) {
-            case MaterialDesc::Type::Diffuse: {
-                L += beta * directDiffuse(ctx, region, h.p, h.n, ray.d, s.material.albedo, rng);
-                // Light that reaches the surface after scattering in a medium
-                // (what shadow rays miss): continue the path in a cosine-
-                // sampled direction, marching the media it crosses, as a
-                // scattering event of max_depth. The weight is the albedo.
-                if (++diffuseBounces >= scene.desc.render.maxDepth) return {L, 0.f};
-                beta *= s.material.albedo;
-                const float m = maxComponent(beta);
-                if (m < RouletteThreshold) {
-                    if (rng.uniform() * RouletteThreshold >= m) return {L, 0.f};
-                    beta /= m / RouletteThreshold;
-                }
-                const Vec3 nf = dot(h.n, ray.d) < 0 ? h.n : -h.n;
-                const float u1 = rng.uniform(), u2 = rng.uniform();
-                const Vec3 d = directionAround(nf, std::sqrt(1 - u1), u2);
-                ray = Ray{offsetRayOrigin(scene, h.p, nf, d), d};
-                lightsCounted = true;
-                break;
-            }
-            case MaterialDesc::Type::Interface:
-                region = entering ? s.interiorRegion : s.exteriorRegion;
-                ray.o = offsetRayOrigin(scene, h.p, h.n, ray.d);
-                break;
-            case MaterialDesc::Type::Dielectric: {
-                // Smooth Fresnel: reflect with probability F, else refract;
-                // the weights F/F and (1-F)/(1-F) cancel. The shading
-                // normal bends the directions; the geometric normal decides
-                // the side, and wins when the two disagree.
-                float eta = entering ? s.material.ior : 1 / s.material.ior;
-                Vec3 ng = entering ? h.n : -h.n;  // faces the incoming ray
-                Vec3 n = dot(h.ns, ng) > 0 ? h.ns : -h.ns;
-                if (-dot(ray.d, n) <= 0) n = ng;  // shading normal faces away from the ray
-                float cosI = -dot(ray.d, n), cosT;
-                float F = fresnelDielectric(cosI, eta, &cosT);
-                bool reflect = rng.uniform() < F;
-                Vec3 d = reflect ? ray.d + n * (2 * cosI) : ray.d / eta + n * (cosI / eta - cosT);
-                if (reflect ? dot(d, ng) <= 0 : dot(d, ng) >= 0) {
-                    // The shading normal sent the ray to the wrong side of
-                    // the true surface: redo the event with the geometric one.
-                    cosI = -dot(ray.d, ng);
-                    F = fresnelDielectric(cosI, eta, &cosT);
-                    reflect = reflect || F >= 1;
-                    d = reflect ? ray.d + ng * (2 * cosI) : ray.d / eta + ng * (cosI / eta - cosT);
-                }
-                if (!reflect) region = entering ? s.interiorRegion : s.exteriorRegion;
-                if (reflect || s.material.ior != 1.f) lightsCounted = false;  // shadow rays cannot follow this
-                d = normalize(d);
-                ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
-                break;
-            }
+        const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
+        const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
+        if (e.kind == SurfaceEvent::Kind::Diffuse) {
+            const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
+            ScatterVertex v{h.p, ray.d, nullptr, h.n, albedo};
+            L += beta * directLight(ctx, region, v, rng, {});
+            // Light that reaches the surface after scattering in a medium
+            // (what shadow rays miss): continue the path in the cosine-
+            // sampled direction, marching the media it crosses, as a
+            // scattering event of max_depth; lights were counted above.
+            if (++diffuseBounces >= scene.desc.render.maxDepth) return {L, 0.f};
+            beta *= e.weight;
+            if (!russianRoulette(beta, rng)) return {L, 0.f};
+            lightsCounted = true;
+        } else {
+            beta *= e.weight;
+            if (!e.straight) lightsCounted = false;  // shadow rays cannot follow a reflected or bent path
         }
+        ray = e.ray;
+        region = e.region;
     }
 }
 
 CacheLookup& SegmentMarcher::cacheLookup(ThreadContext& ctx) const {
-    if (!ctx.cacheLookup) ctx.cacheLookup = std::make_unique<CacheLookup>(*mIllumination->cache);
-    return *ctx.cacheLookup;
+    MarcherScratch& m = scratch(ctx);
+    if (!m.cacheLookup) m.cacheLookup = std::make_unique<CacheLookup>(*mIllumination->cache);
+    return *m.cacheLookup;
 }
 
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
                                   const MediumPoint& mp, Rng& rng) const {
-    if (mp.count == 0) return Color(0);
+    if (!mp.scatters()) return Color(0);
     ++ctx.counters.liSamples;
     const Illumination& il = *mIllumination;
-    if (il.liFromCache) {
+    if (il.li == LiSource::Cache) {
         if (!il.cache) return Color(0);  // nothing scatters anywhere
         CacheLookup& c = cacheLookup(ctx);
         c.setDirection(-rayDir);
         return Color(c.at(x));
     }
-    Color Li = directInScattering(ctx, region, x, rayDir, mp, rng);
+    Color Li = directLight(ctx, region, ScatterVertex{x, rayDir, &mp.phase}, rng, {});
     if (il.indirect)
-        Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return phaseMixture(mp, c); });
+        Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
     return Li;
 }
 

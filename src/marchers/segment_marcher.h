@@ -1,16 +1,36 @@
-// The camera-path loop the three ray marchers share: surfaces (glass refracts
-// the camera ray into the medium it holds, interfaces switch regions, diffuse
-// surfaces end the path with direct light), sphere lights and the background,
-// with a marcher-specific march of each segment between surfaces; and the one
-// L_i estimate all of them use at their samples, so that comparisons are fair.
+// The camera-path loop the three ray marchers share: surfaces (the shared
+// surface event: glass refracts the camera ray into the medium it holds,
+// interfaces switch regions, diffuse surfaces add direct light and continue
+// the path by a cosine bounce), sphere lights and the background, with a
+// marcher-specific march of each segment between surfaces; and the one L_i
+// estimate all of them use at their samples, so that comparisons are fair.
 #pragma once
 
 #include <memory>
+#include <vector>
 
-#include "marchers/illumination.h"
+#include "cache/cache_lookup.h"
+#include "illumination/illumination.h"
 #include "marchers/marcher.h"
+#include "marchers/ray_pdf.h"
+#include "transport/media_point.h"
 
 namespace vdbmarch {
+
+// Per-thread scratch of the marchers (ThreadContext::extension).
+struct MarcherScratch final : ThreadContextExtension {
+    // The sampled marchers' per-ray histogram: steps, their media, the cache.
+    std::vector<PdfStep> pdfSteps;
+    std::vector<Color> stepSigmaS, stepKappa, stepT;
+    std::vector<float> stepH;
+    RayPdf rayPdf;
+    std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
+    // The guided marcher's pre-pass (eq. 17's scale): march without sampling
+    // and sum each segment's throughput times its histogram integral.
+    bool measureOnly = false;
+    double measuredGuided = 0;
+    size_t measuredSegments = 0;  // segments through scattering media
+};
 
 class SegmentMarcher : public Marcher {
 public:
@@ -38,14 +58,12 @@ protected:
     bool activeIntervals(ThreadContext& ctx, int region, const Ray& ray, float tEnd, bool& infiniteTail) const;
     void applyInfiniteTail(int region, Color& beta) const;
 
+    static MarcherScratch& scratch(ThreadContext& ctx) { return ctx.extensionAs<MarcherScratch>(); }
     CacheLookup& cacheLookup(ThreadContext& ctx) const;
 
     const Scene& mScene;
     std::shared_ptr<const Illumination> mIllumination;
 };
-
-// Throughput below which Russian roulette decides whether a ray goes on.
-constexpr float RouletteThreshold = 1e-3f;
 
 // One step of length dx in a medium with extinction kappa: its transmittance,
 // and the fraction absorbed and scattered, (1 - e^{-kappa dx}) sigma_x / kappa,

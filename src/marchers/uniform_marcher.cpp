@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "marchers/segment_marcher.h"
+#include "transport/roulette.h"
 
 namespace vdbmarch {
 
@@ -40,14 +41,9 @@ private:
                 StepTerms st = stepTerms(mp, dx);
                 L += beta * (st.absorbedA * mp.emission + st.absorbedS * Li);
                 beta *= st.T;
-                float m = maxComponent(beta);
-                if (m < RouletteThreshold) {
-                    float q = m / RouletteThreshold;
-                    if (rng.uniform() >= q) {
-                        beta = Color(0);
-                        return false;
-                    }
-                    beta /= q;
+                if (!russianRoulette(beta, rng)) {
+                    beta = Color(0);
+                    return false;
                 }
             }
         }

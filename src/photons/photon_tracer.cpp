@@ -8,7 +8,10 @@
 #include <tbb/parallel_for.h>
 
 #include "core/sampling.h"
-#include "marchers/march_common.h"
+#include "transport/media_point.h"
+#include "transport/roulette.h"
+#include "transport/surface_event.h"
+#include "transport/tracking.h"
 
 namespace vdbmarch {
 
@@ -74,12 +77,16 @@ public:
     }
 
 private:
-    void follow(ThreadContext& ctx, Ray ray, Color power, int channel, Rng& rng, std::vector<Photon>& out) const {
+    // Follows a photon of power `power` from ray.o: stored at every real
+    // collision in a medium (eq. 4), absorbed or scattered by the albedo,
+    // surfaces by the shared surface event (importance transport).
+    void follow(ThreadContext& ctx, Ray ray, const Color& power, int channel, Rng& rng, std::vector<Photon>& out) const {
         const Scene& scene = mScene;
         const int maxDepth = scene.desc.render.maxDepth;
         int region = regionAtRayStart(scene, ray);
         int depth = 0, surfaceBounces = 0;
         bool direct = true;
+        Color beta(1);  // throughput relative to the emitted power
         MediumPoint mp;
         while (true) {
             SurfaceHit h;
@@ -89,7 +96,7 @@ private:
             float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
 
             // Delta tracking to the next real collision; the photon is stored
-            // there, then scatters with probability albedo (Russian roulette).
+            // there, then scatters with probability albedo.
             bool scattered = false, ended = false;
             deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
                 evalMedia(ctx, region, x, mp);
@@ -100,59 +107,40 @@ private:
                 Photon ph;
                 ph.position = x;
                 ph.direction = encodeDirection(ray.d);
-                ph.weight = power / st;  // grey extinction: sigma_t is the same in every channel
-                float gMean = 0, ssSum = 0;
-                for (int i = 0; i < mp.count; ++i) {
-                    gMean += average(mp.sigmaS[i]) * mp.g[i];
-                    ssSum += average(mp.sigmaS[i]);
-                }
-                ph.flags = Photon::packFlags(direct, ssSum > 0 ? gMean / ssSum : 0.f);
+                ph.weight = power * beta / st;  // grey extinction: sigma_t is the same in every channel
+                float w[2];
+                mp.phase.legendreWeights(1, w);
+                ph.flags = Photon::packFlags(direct, w[1]);
                 out.push_back(ph);
                 if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
                     ended = true;
                     return false;
                 }
-                if (channel < 0) power *= mp.sigma_s / ss;  // per-channel albedo over its mean
+                if (channel < 0) beta *= mp.sigma_s / ss;  // per-channel albedo over its mean
                 float pdf;
-                ray = Ray{x, samplePhaseMixture(mp, ray.d, rng, power, pdf)};
+                const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+                ray = Ray{x, mp.phase.sample(ray.d, u0, u1, u2, beta, pdf)};
                 direct = false;
                 scattered = true;
                 return false;
             });
             if (ended) return;
             if (scattered) {
-                if (!std::isfinite(maxComponent(power))) return;
+                if (!isFinite(beta) || !russianRoulette(beta, rng, ScatterRouletteThreshold)) return;
                 continue;
             }
             if (light >= 0 || !hit) return;  // absorbed by a light, or escaped
             if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return;
-            const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
-            bool entering = dot(ray.d, h.n) < 0;
-            if (s.material.type == MaterialDesc::Type::Interface) {
-                region = entering ? s.interiorRegion : s.exteriorRegion;
-                ray.o = offsetRayOrigin(scene, h.p, h.n, ray.d);
-                continue;
-            }
-            if (s.material.type == MaterialDesc::Type::Diffuse) {
-                if (++depth >= maxDepth) return;
-                float a = maxComponent(s.material.albedo);
-                if (!(rng.uniform() < a)) return;  // Russian roulette by albedo
-                power *= s.material.albedo / a;
-                Vec3 nf = entering ? h.n : -h.n;
-                float u1 = rng.uniform(), u2 = rng.uniform();
-                Vec3 wi = directionAround(nf, std::sqrt(1 - u1), u2);
-                ray = Ray{offsetRayOrigin(scene, h.p, h.n, wi), wi};
-                direct = false;
-                continue;
-            }
-            // Dielectric: reflection or refraction by Fresnel. Index-matched
-            // glass is crossed straight, as shadow rays cross it, so such
-            // photons stay direct.
-            bool refracted;
-            Vec3 d = sampleDielectric(ray.d, h.n, s.material.ior, rng.uniform(), refracted);
-            if (refracted) region = entering ? s.interiorRegion : s.exteriorRegion;
-            if (s.material.ior != 1.f) direct = false;
-            ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
+            const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
+            const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Importance);
+            if (e.kind == SurfaceEvent::Kind::Diffuse && ++depth >= maxDepth) return;
+            beta *= e.weight;
+            // Index-matched glass is crossed straight, as shadow rays cross
+            // it, so such photons stay direct.
+            if (!e.straight) direct = false;
+            if (!russianRoulette(beta, rng, ScatterRouletteThreshold)) return;
+            ray = e.ray;
+            region = e.region;
         }
     }
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "scene/scene_desc.h"
+#include "parse/scene_json.h"
 
 namespace vdbmarch {
 

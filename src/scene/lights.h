@@ -5,7 +5,7 @@
 #pragma once
 
 #include "core/math.h"
-#include "scene/scene_desc.h"
+#include "parse/scene_desc.h"
 
 namespace vdbmarch {
 

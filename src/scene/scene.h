@@ -7,7 +7,7 @@
 
 #include "scene/camera.h"
 #include "scene/lights.h"
-#include "scene/scene_desc.h"
+#include "parse/scene_desc.h"
 #include "scene/surfaces.h"
 #include "volume/medium.h"
 

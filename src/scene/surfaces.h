@@ -8,8 +8,8 @@
 
 #include "core/math.h"
 #include "core/transform.h"
-#include "scene/mesh.h"
-#include "scene/scene_desc.h"
+#include "parse/mesh.h"
+#include "parse/scene_desc.h"
 
 struct RTCGeometryTy;  // Embree's geometry handle, kept out of this header
 

@@ -4,7 +4,7 @@
 #include <openvdb/tools/VolumeToMesh.h>
 
 #include "core/error.h"
-#include "scene/mesh.h"
+#include "parse/mesh.h"
 #include "volume/vdb_io.h"
 #include "volume/vdb_mesh.h"
 

@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "scene/mesh.h"
+#include "parse/mesh.h"
 
 namespace vdbmarch {
 

@@ -1,4 +1,4 @@
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/image.h"
 #include "image/metrics.h"

@@ -9,7 +9,7 @@
 #include <csignal>
 #include <fstream>
 
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace vdbmarch {
 namespace {

@@ -13,12 +13,12 @@
 #include <regex>
 
 #include "core/error.h"
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 #include "image/exr_io.h"
-#include "render.h"
+#include "render/render.h"
 #include "scene/auto_scene.h"
 #include "scene/scene.h"
-#include "scene/scene_desc.h"
+#include "parse/scene_desc.h"
 #include "volume/medium.h"
 
 #include "test_helpers.h"

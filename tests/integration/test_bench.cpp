@@ -10,7 +10,7 @@
 #include <random>
 #include <sstream>
 
-#include "bench.h"
+#include "app/bench.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
 #include "image/png_io.h"

@@ -9,7 +9,7 @@
 #include <openvdb/openvdb.h>
 
 #include "image/image.h"
-#include "render.h"
+#include "render/render.h"
 #include "scene/scene.h"
 
 namespace vdbmarch::testing {

@@ -13,7 +13,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
-#include "render.h"
+#include "render/render.h"
 #include "test_helpers.h"
 
 namespace vdbmarch::testing {

@@ -75,7 +75,7 @@ Estimate meanAndError(const std::vector<double>& v) {
 // reference tracer: phase-sample the light's travel direction t' around wo
 // and take the radiance arriving along it.
 Estimate referenceIndirect(const Scene& scene, const Vec3& x, const Vec3& wo, float g, int samples) {
-    auto tracer = makeMarcher("reference", scene);
+    auto tracer = makeMarcher(Method::Reference, scene);
     ThreadContext ctx(scene);
     std::vector<double> v;
     v.reserve(size_t(samples));

@@ -9,7 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "cache/bake.h"
+#include "cache/cache_build.h"
+#include "illumination/bake.h"
 #include "cache/sh.h"
 #include "core/error.h"
 #include "core/rng.h"

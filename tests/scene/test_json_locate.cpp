@@ -2,8 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "scene/json_locate.h"
-#include "scene/scene_desc.h"
+#include "parse/json_locate.h"
+#include "parse/scene_desc.h"
 
 namespace vdbmarch {
 namespace {

@@ -1,4 +1,4 @@
-#include "scene/mesh.h"
+#include "parse/mesh.h"
 
 #include "core/error.h"
 

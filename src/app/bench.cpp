@@ -1,4 +1,4 @@
-#include "bench.h"
+#include "app/bench.h"
 
 #include <sys/stat.h>
 
@@ -12,13 +12,14 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/rng.h"
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/metrics.h"
 #include "image/png_io.h"
 #include "core/transform.h"
-#include "render.h"
+#include "render/render.h"
 
 namespace vdbmarch {
 
@@ -194,7 +195,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     // Loaded once: every render below only changes the render settings.
     std::unique_ptr<Scene> scene = buildScene(baseScene);
     auto renderWith = [&](const std::string& method, int spp, uint64_t seed, const RenderOptions& ro) {
-        scene->desc.render.method = method;
+        if (!parseMethod(method, scene->desc.render.method)) throw InputError(str("bench: unknown method \"", method, "\""));
         scene->desc.render.spp = spp;
         scene->desc.render.seed = seed;
         return renderImage(*scene, ro);
@@ -208,7 +209,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
         reference = readExr(o.referencePath);
         result.referenceImage = o.referencePath;
     } else {
-        uint64_t h = hashValues(std::hash<std::string>()(baseScene.json.dump()), uint64_t(o.referenceSpp));
+        uint64_t h = hashValues(fnv1a64(baseScene.jsonText), uint64_t(o.referenceSpp));
         char name[64];
         std::snprintf(name, sizeof(name), "reference_%016llx.exr", static_cast<unsigned long long>(h));
         std::string path = o.outDir + "/" + name, halfPath = path + ".half.exr";

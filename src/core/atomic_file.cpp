@@ -1,4 +1,4 @@
-#include "image/atomic_file.h"
+#include "core/atomic_file.h"
 
 #include "core/error.h"
 

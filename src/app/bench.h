@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "image/image.h"
-#include "scene/scene_desc.h"
+#include "parse/scene_desc.h"
 
 namespace vdbmarch {
 

@@ -1,4 +1,4 @@
-#include "render.h"
+#include "render/render.h"
 
 #include <atomic>
 #include <chrono>
@@ -79,8 +79,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         illumination = std::make_shared<Illumination>(prepareIllumination(scene, rs.method, options.illumination));
         marcher = makeMarcher(rs.method, scene, illumination);
     });
-    result.illuminationSeconds = illumination->seconds;
-    result.photons = illumination->photons;
+    result.illuminationSeconds = illumination->stats.seconds;
+    result.photons = illumination->stats.photons;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
 
     // One pass renders samples [s0, s1) of every pixel. Each pixel sums its

@@ -1,4 +1,4 @@
-#include "scene/json_reader.h"
+#include "parse/json_reader.h"
 
 #include <cmath>
 

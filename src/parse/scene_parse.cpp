@@ -8,10 +8,11 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "marchers/marcher.h"
-#include "scene/json_locate.h"
-#include "scene/json_reader.h"
-#include "scene/scene_desc.h"
+#include "core/hash.h"
+#include "parse/scene_json.h"
+#include "parse/json_locate.h"
+#include "parse/json_reader.h"
+#include "parse/scene_desc.h"
 
 namespace vdbmarch {
 
@@ -261,7 +262,11 @@ RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
                  "pixel_jitter", "exposure", "majorant", "li", "ray_samples"});
     RenderSettings s;
-    s.method = r.choice("method", s.method, marcherNames());  // the factory table is the one list
+    {
+        std::vector<std::string> names;
+        for (Method m : allMethods()) names.push_back(methodName(m));
+        parseMethod(r.choice("method", methodName(s.method), names), s.method);
+    }
     s.spp = r.integer("spp", s.spp, 1, 1 << 24);
     if (r.has("step")) s.step = float(r.positive("step", 1));
     if (r.has("shadow_step")) s.shadowStep = float(r.positive("shadow_step", 1));
@@ -277,7 +282,7 @@ RenderSettings parseRender(const JsonReader& r) {
     s.pixelJitter = r.boolean("pixel_jitter", s.pixelJitter);
     s.exposure = float(r.numberIn("exposure", 0, -64, 64));
     s.globalMajorant = r.choice("majorant", "local", {"local", "global"}) == "global";
-    s.li = r.choice("li", s.li, {"photons", "cache"});
+    parseLiSource(r.choice("li", liSourceName(s.li), {"photons", "cache"}), s.li);
     s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
     return s;
 }
@@ -313,6 +318,20 @@ CacheSettings parseCache(const JsonReader& r) {
 
 }  // namespace
 
+std::string sceneHash(const SceneDesc& desc) {
+    Json j = Json::parse(desc.jsonText);
+    j.erase("camera");
+    j.erase("photons");
+    j.erase("cache");
+    j.erase("render");
+    j["max_depth"] = desc.render.maxDepth;
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(fnv1a64(j.dump())));
+    return buf;
+}
+
+std::string prettySceneJson(const SceneDesc& desc, int indent) { return Json::parse(desc.jsonText).dump(indent); }
+
 std::string resolvePath(const std::string& baseDir, const std::string& path) {
     if (path.empty() || path[0] == '/' || baseDir.empty()) return path;
     return baseDir + "/" + path;
@@ -323,7 +342,7 @@ SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
     scene.file = file;
     size_t slash = file.find_last_of('/');
     scene.baseDir = slash == std::string::npos ? "." : file.substr(0, slash == 0 ? 1 : slash);
-    scene.json = doc;
+    scene.jsonText = doc.dump();
     JsonReader root(doc, file, "");
     root.allowOnly({"camera", "lights", "media", "surfaces", "background", "render", "photons", "cache"});
     if (root.has("camera")) scene.camera = parseCamera(root.object("camera"));

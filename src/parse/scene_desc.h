@@ -6,10 +6,9 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "core/math.h"
 #include "core/transform.h"
+#include "parse/method.h"
 
 namespace vdbmarch {
 
@@ -62,7 +61,7 @@ struct SurfaceDesc {
 };
 
 struct RenderSettings {
-    std::string method = "uniform";
+    Method method = Method::Uniform;
     int spp = 1;
     float step = 0;        // world units; 0 = automatic
     float shadowStep = 0;  // 0 = same as step
@@ -73,10 +72,8 @@ struct RenderSettings {
     bool pixelJitter = true;  // false: one ray through each pixel centre
     float exposure = 0;       // PNG preview, stops
     bool globalMajorant = false;  // reference: one majorant per grid (benchmarks only)
-    // How the marchers estimate L_i at their samples: "photons" (shadow rays
-    // for direct light plus the photon map's non-direct photons) or "cache"
-    // (the radiance cache alone: a fast, biased preview).
-    std::string li = "photons";
+    // How the marchers estimate L_i at their samples.
+    LiSource li = LiSource::Photons;
     int raySamples = 4;  // transmittance and guided: L_i samples per ray segment (mean for guided)
 };
 
@@ -107,7 +104,7 @@ struct SceneDesc {
     RenderSettings render;
     PhotonSettings photons;
     CacheSettings cache;
-    nlohmann::json json;  // the effective document, recorded in outputs
+    std::string jsonText;  // the effective document (compact JSON), recorded in outputs
 };
 
 // Parses scene JSON text; `file` is used in messages and to resolve paths.
@@ -117,10 +114,11 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file,
                          const std::vector<std::string>& overrides = {});
 // Reads and parses a scene file.
 SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides = {});
-// Applies one "key.path=value" override (value parsed as JSON, else string).
-void applyOverride(nlohmann::json& doc, const std::string& assignment);
-// Parses an already-built document (used for bare .vdb scenes).
-SceneDesc parseSceneJson(const nlohmann::json& doc, const std::string& file);
+
+// Hash of everything in the scene that changes the light field (media,
+// lights, surfaces, background, max_depth) but not the camera or render
+// settings: a cache baked for one scene is refused for another.
+std::string sceneHash(const SceneDesc& desc);
 
 std::string resolvePath(const std::string& baseDir, const std::string& path);
 

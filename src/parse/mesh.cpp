@@ -1,6 +1,7 @@
-#include "scene/mesh.h"
+#include "parse/mesh.h"
 
 #include "core/error.h"
+#include "core/hash.h"
 
 #include <tiny_obj_loader.h>
 
@@ -534,14 +535,9 @@ TriangleMesh loadPly(const std::string& path) {
 // Identical positions weld; -0 and +0 compare equal, so hash them alike.
 struct PositionHash {
     size_t operator()(const Vec3& p) const {
-        size_t h = 1469598103934665603ull;
-        for (int a = 0; a < 3; ++a) {
-            float v = p[a] + 0.f;  // -0 + 0 = +0
-            uint32_t bits;
-            std::memcpy(&bits, &v, 4);
-            h = (h ^ bits) * 1099511628211ull;
-        }
-        return h;
+        Fnv1a h;
+        for (int a = 0; a < 3; ++a) h.addValue(p[a] + 0.f);  // -0 + 0 = +0
+        return size_t(h.value);
     }
 };
 

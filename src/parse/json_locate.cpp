@@ -1,4 +1,4 @@
-#include "scene/json_locate.h"
+#include "parse/json_locate.h"
 
 #include <cctype>
 

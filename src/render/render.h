@@ -8,7 +8,7 @@
 
 #include "core/stats.h"
 #include "image/image.h"
-#include "marchers/illumination.h"
+#include "illumination/illumination.h"
 #include "scene/scene.h"
 
 namespace vdbmarch {

@@ -1,0 +1,61 @@
+#include "transport/direct_light.h"
+
+#include <cmath>
+
+#include "core/sampling.h"
+
+namespace vdbmarch {
+
+Color ScatterVertex::f(const Vec3& wi) const {
+    // cos between the light's travel direction (-wi) and the scattered
+    // direction (-d).
+    if (phase) return phase->eval(dot(wi, d));
+    const Vec3 nf = dot(n, d) < 0 ? n : -n;
+    const float c = dot(wi, nf);
+    return c > 0 ? albedo * (c * InvPi) : Color(0);
+}
+
+float ScatterVertex::pdf(const Vec3& wi) const {
+    if (phase) return phase->pdf(dot(wi, d));
+    const Vec3 nf = dot(n, d) < 0 ? n : -n;
+    return std::max(0.f, dot(wi, nf)) * InvPi;
+}
+
+Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng, const DirectLightOptions& o) {
+    const Scene& scene = ctx.scene;
+    Color L(0);
+    Vec3 origin = v.p, nf;
+    if (!v.phase) {  // leave the surface on the side the path arrived from
+        nf = dot(v.n, v.d) < 0 ? v.n : -v.n;
+        origin = v.p + nf * (1e-5f * std::max(scene.sceneScale, maxComponent(max(v.p, -v.p))));
+    }
+    for (const Light& light : scene.lights) {
+        LightSample ls;
+        const float u1 = rng.uniform(), u2 = rng.uniform();
+        if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;
+        const Color f = v.f(ls.wi);
+        if (isBlack(f)) continue;
+        const float w = o.misWithPathHits && light.isSphere() ? powerHeuristic(ls.pdf, v.pdf(ls.wi)) : 1.f;
+        L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) * w;
+    }
+    if (o.sampleBackground && !isBlack(scene.background)) {
+        // One direction sampled by f: the pdf cancels f up to the mixture's weight.
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        Color weight(1);
+        Vec3 wi;
+        if (v.phase) {
+            // The scattered light leaves along -d, so the arriving light's
+            // direction -wi is drawn around -d: wi around d.
+            float pdf;
+            wi = v.phase->sample(v.d, u0, u1, u2, weight, pdf);
+            if (!(pdf > 0)) return L;
+        } else {
+            wi = directionAround(nf, std::sqrt(1 - u1), u2);
+            weight = v.albedo;
+        }
+        L += weight * scene.background * shadowTransmittance(ctx, region, origin, wi, Infinity, rng, o.transmittance);
+    }
+    return L;
+}
+
+}  // namespace vdbmarch

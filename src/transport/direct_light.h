@@ -1,0 +1,46 @@
+// Next-event estimation, written once for the marchers' L_i and the
+// reference tracer: at a scattering point in a medium (phase mixture) or on
+// a diffuse surface (albedo cos / pi), a sample of every light with its
+// shadow-ray transmittance, and optionally one sample of the constant
+// background.
+#pragma once
+
+#include "core/rng.h"
+#include "transport/phase.h"
+#include "transport/transmittance.h"
+
+namespace vdbmarch {
+
+// Where light is gathered: a medium point (phase != null) or a diffuse
+// surface point (geometric normal n, albedo).
+struct ScatterVertex {
+    Vec3 p;
+    Vec3 d;  // travel direction of the path arriving here (the light leaves along -d)
+    const PhaseMixture* phase = nullptr;
+    Vec3 n;  // surface only
+    Color albedo{0, 0, 0};
+
+    // f (phase, or albedo cos / pi) for light arriving from direction wi; 0
+    // below a surface.
+    Color f(const Vec3& wi) const;
+    // Solid-angle pdf with which the path itself would sample wi (MIS).
+    float pdf(const Vec3& wi) const;
+};
+
+struct DirectLightOptions {
+    TransmittanceEstimator transmittance = TransmittanceEstimator::Stepped;
+    // The path goes on from here by sampling f, and counts the sphere lights
+    // it hits: weight both strategies by the power heuristic.
+    bool misWithPathHits = false;
+    // The path does not go on: sample the constant background here (by f).
+    bool sampleBackground = true;
+};
+
+Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng, const DirectLightOptions& options);
+
+inline float powerHeuristic(float a, float b) {
+    const float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,101 @@
+#include "transport/surface_event.h"
+
+#include <cmath>
+
+#include "core/sampling.h"
+
+namespace vdbmarch {
+
+Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d) {
+    float eps = 1e-5f * std::max(scene.sceneScale, maxComponent(max(p, -p)));
+    return p + (dot(n, d) > 0 ? n : -n) * eps;
+}
+
+int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tMax, float& t) {
+    if (!scene.hasSphereLights) return -1;
+    int best = -1;
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        float ti;
+        if (scene.lights[i].intersect(r, tMin, tMax, ti)) {
+            tMax = ti;
+            t = ti;
+            best = int(i);
+        }
+    }
+    return best;
+}
+
+int regionAtRayStart(const Scene& scene, const Ray& r) {
+    SurfaceHit h;
+    if (!scene.surfaceSet->intersect(r, 0.f, Infinity, h)) return Scene::WorldRegion;
+    const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+    return dot(r.d, h.n) > 0 ? s.interiorRegion : s.exteriorRegion;
+}
+
+bool crossedByShadowRays(const MaterialDesc& m) {
+    return m.type == MaterialDesc::Type::Interface || (m.type == MaterialDesc::Type::Dielectric && m.ior == 1.f);
+}
+
+SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& h, const Vec3& d, int region, const float u[3],
+                                TransportMode mode) {
+    const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+    const bool entering = dot(d, h.n) < 0;
+    const int across = entering ? s.interiorRegion : s.exteriorRegion;
+    const Vec3 ng = entering ? h.n : -h.n;  // geometric normal on the arriving side
+    SurfaceEvent e;
+    switch (s.material.type) {
+        case MaterialDesc::Type::Interface:
+            e.kind = SurfaceEvent::Kind::Interface;
+            e.straight = true;
+            e.region = across;
+            e.ray = Ray{offsetRayOrigin(scene, h.p, h.n, d), d};
+            return e;
+        case MaterialDesc::Type::Diffuse: {
+            // Lambertian on the arriving side: cosine sampling, so f cos / pdf = albedo.
+            const float cosT = std::sqrt(1 - u[1]);
+            const Vec3 wi = directionAround(ng, cosT, u[2]);
+            e.kind = SurfaceEvent::Kind::Diffuse;
+            e.region = region;
+            e.weight = s.material.albedo;
+            e.pdf = cosT * InvPi;
+            e.ray = Ray{offsetRayOrigin(scene, h.p, ng, wi), wi};
+            return e;
+        }
+        case MaterialDesc::Type::Dielectric:
+            break;
+    }
+    // Smooth Fresnel: reflect with probability F, else refract; the weights
+    // F/F and (1-F)/(1-F) cancel.
+    const float ior = s.material.ior;
+    const float eta = entering ? ior : 1 / ior;
+    Vec3 n = dot(h.ns, ng) > 0 ? h.ns : -h.ns;
+    if (-dot(d, n) <= 0) n = ng;  // the shading normal faces away from the ray
+    float cosI = -dot(d, n), cosT;
+    float F = fresnelDielectric(cosI, eta, &cosT);
+    bool reflect = u[0] < F;
+    Vec3 wo = reflect ? d + n * (2 * cosI) : d / eta + n * (cosI / eta - cosT);
+    if (reflect ? dot(wo, ng) <= 0 : dot(wo, ng) >= 0) {
+        // The shading normal sent the ray to the wrong side of the true
+        // surface: redo the event with the geometric one.
+        n = ng;
+        cosI = -dot(d, n);
+        F = fresnelDielectric(cosI, eta, &cosT);
+        reflect = reflect || F >= 1;
+        wo = reflect ? d + n * (2 * cosI) : d / eta + n * (cosI / eta - cosT);
+    }
+    wo = normalize(wo);
+    e.kind = reflect ? SurfaceEvent::Kind::Reflect : SurfaceEvent::Kind::Refract;
+    e.straight = !reflect && ior == 1.f;
+    e.region = reflect ? region : across;
+    if (mode == TransportMode::Importance && n != ng) {
+        // Adjoint of the shading-normal BSDF: |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|),
+        // wo towards where the photon came from, wi where it goes.
+        const float num = std::fabs(dot(d, n)) * std::fabs(dot(wo, ng));
+        const float den = std::fabs(dot(d, ng)) * std::fabs(dot(wo, n));
+        e.weight = Color(den > 0 ? num / den : 0.f);
+    }
+    e.ray = Ray{offsetRayOrigin(scene, h.p, h.n, wo), wo};
+    return e;
+}
+
+}  // namespace vdbmarch

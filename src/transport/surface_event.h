@@ -1,0 +1,47 @@
+// What happens where a path meets a surface, written once for camera paths,
+// the reference tracer and photons: interfaces switch regions, diffuse
+// surfaces bounce (cosine-sampled), smooth dielectrics reflect or refract by
+// Fresnel. The shading-normal rule: the shading normal (smooth_normals)
+// bends the direction; the geometric normal decides which side a ray is on,
+// and wins when the shading normal would send the ray to the wrong side.
+// With shading normals the scattering is not symmetric, so photons (which
+// carry importance's adjoint) take Veach's correction (thesis, eq. 5.19).
+#pragma once
+
+#include "core/rng.h"
+#include "scene/scene.h"
+
+namespace vdbmarch {
+
+enum class TransportMode { Radiance, Importance };  // camera paths; photons
+
+struct SurfaceEvent {
+    enum class Kind { Interface, Diffuse, Reflect, Refract } kind = Kind::Interface;
+    Ray ray;                // the continuing ray, its origin offset to the side it leaves on
+    int region = 0;         // the region it travels in
+    Color weight{1, 1, 1};  // f cos / pdf (the diffuse albedo; Fresnel choices cancel)
+    float pdf = 0;          // solid-angle pdf of a diffuse bounce (MIS); 0 for the delta events
+    // The ray goes on unbent (an interface, or refraction through index-
+    // matched glass): a shadow ray would have followed it.
+    bool straight = false;
+};
+
+// The event at `hit` for a ray travelling along d in `region`; u: the three
+// uniforms it may use (Fresnel choice, then the diffuse direction).
+SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& hit, const Vec3& d, int region, const float u[3],
+                                TransportMode mode);
+
+// True when a straight shadow ray crosses the surface (interfaces and
+// index-matched glass); every other surface blocks it.
+bool crossedByShadowRays(const MaterialDesc& material);
+
+// Offset origin for a ray leaving a surface at p in direction d.
+Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d);
+
+// Region that a ray starting at r.o is in, from the first surface it meets.
+int regionAtRayStart(const Scene& scene, const Ray& r);
+
+// Closest sphere light hit in (tMin, tMax); returns the light index or -1.
+int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tMax, float& t);
+
+}  // namespace vdbmarch

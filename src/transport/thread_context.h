@@ -1,0 +1,36 @@
+// Per-thread state of every path loop: one medium query per medium (VDB
+// accessors), scratch vectors reused across rays, and the render counters.
+// An estimator that needs scratch of its own keeps it in `extension`, made
+// on first use, so this layer knows nothing of the estimators above it.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/stats.h"
+#include "scene/scene.h"
+
+namespace vdbmarch {
+
+struct ThreadContextExtension {
+    virtual ~ThreadContextExtension() = default;
+};
+
+struct ThreadContext {
+    explicit ThreadContext(const Scene& s);
+    const Scene& scene;
+    std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
+    std::vector<Interval> intervals, shadowIntervals, scratch;
+    std::vector<MajorantSegment> majorants, scratchSegments;
+    RenderCounters counters;
+    std::unique_ptr<ThreadContextExtension> extension;
+
+    // The extension as type T, made on first use.
+    template <typename T, typename... Args>
+    T& extensionAs(Args&&... args) {
+        if (!extension) extension = std::make_unique<T>(std::forward<Args>(args)...);
+        return static_cast<T&>(*extension);
+    }
+};
+
+}  // namespace vdbmarch

@@ -1,0 +1,60 @@
+// Majorants and delta tracking: the free-flight sampler of the reference
+// tracer and the photon tracer. The medium yields (t0, t1, sigma_maj)
+// segments from its VDB tree (one per 8^3 block); the caller's callback
+// handles each tentative collision.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "core/rng.h"
+#include "transport/thread_context.h"
+
+namespace vdbmarch {
+
+// Extinction used for tracking: channel c, or (grey media, channel < 0) channel 0.
+inline float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[channel < 0 ? 0 : channel]; }
+
+// One medium's majorant segments (of its density) along [0, tEnd): local (per
+// VDB block) by default; with render.global_majorant, the grid's maximum over
+// its bounding box (the classic baseline the local majorants are benchmarked
+// against).
+void mediumMajorants(ThreadContext& ctx, int medium, const Ray& r, float tEnd, std::vector<MajorantSegment>& out);
+
+// Combined extinction majorant of the region's media along [0, tEnd) for the
+// tracked `channel`.
+void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,
+                     std::vector<MajorantSegment>& out);
+
+// Delta tracking along [0, tEnd) of `ray` in `region`: tentative collisions
+// are drawn at rate sigma_maj against the local majorants (walked lazily for
+// a single medium, so blocks past the first real collision are never
+// visited), and collide(x, sigmaMaj) is called at each until it returns false.
+template <typename Collide>
+void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int channel, Rng& rng, Collide&& collide) {
+    // `ray` is a copy: collide() may replace the caller's ray when it scatters.
+    auto track = [&](const MajorantSegment& seg) {
+        const float sigmaMaj = seg.maxDensity;
+        if (!(sigmaMaj > 0)) return true;
+        double t = seg.t0;
+        while (true) {
+            t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
+            if (t >= seg.t1) return true;
+            if (!collide(ray.at(t), sigmaMaj)) return false;
+        }
+    };
+    const auto& media = ctx.scene.regions[size_t(region)].media;
+    if (media.size() == 1 && !ctx.scene.desc.render.globalMajorant) {
+        const Medium& m = *ctx.scene.media[size_t(media[0])];
+        const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
+        ctx.queries[size_t(media[0])]->forEachMajorant(ray, 0.f, tEnd, [&](const MajorantSegment& s) {
+            return track({s.t0, s.t1, s.maxDensity * k});
+        });
+    } else if (!media.empty()) {
+        regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);
+        for (const auto& seg : ctx.majorants)
+            if (!track(seg)) break;
+    }
+}
+
+}  // namespace vdbmarch

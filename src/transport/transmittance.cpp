@@ -1,0 +1,109 @@
+#include "transport/transmittance.h"
+
+#include <algorithm>
+
+#include "transport/roulette.h"
+#include "transport/tracking.h"
+
+namespace vdbmarch {
+
+namespace {
+
+// Optical depth of the region's media over [0, tEnd) of ray r. Constant
+// media integrate exactly; gridded media are marched with uniform steps at
+// (k + u) * step, an unbiased estimate of the integral of sigma_t. Stops early
+// once every channel's depth exceeds `depthCutoff`.
+Color opticalDepth(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng, float depthCutoff) {
+    Color tau(0);
+    const auto& media = ctx.scene.regions[size_t(region)].media;
+    if (media.empty()) return tau;
+    const float step = ctx.scene.shadowStep;
+    const float u = rng.uniform();
+    for (int mi : media) {
+        MediumQuery& q = *ctx.queries[size_t(mi)];
+        const Medium& m = *ctx.scene.media[size_t(mi)];
+        const Color sigmaT = m.sigma_a + m.sigma_s;
+        float integral;
+        if (q.densityIntegral(r, 0.f, tEnd, integral)) {
+            for (int c = 0; c < 3; ++c)  // unbounded fog: inf * 0 must not make NaN
+                if (integral > 0 && sigmaT[c] > 0) tau[c] += sigmaT[c] * integral;
+            if (minComponent(tau) > depthCutoff) return tau;
+            continue;
+        }
+        ctx.shadowIntervals.clear();
+        q.activeIntervals(r, 0.f, tEnd, ctx.shadowIntervals);
+        float sum = 0;
+        for (const Interval& iv : ctx.shadowIntervals) {
+            // Lattice index in double: k + 1 must never round back to k.
+            double k = std::ceil(double(iv.t0) / step - u);
+            for (double t = (k + u) * step; t < iv.t1; k += 1, t = (k + u) * step) {
+                sum += q.density(r.at(t));
+                ++ctx.counters.shadowSamples;
+                if (minComponent(tau + sigmaT * (sum * step)) > depthCutoff) return tau + sigmaT * (sum * step);
+            }
+        }
+        tau += sigmaT * (sum * step);
+    }
+    return tau;
+}
+
+// Ratio tracking through the region's media over [0, tEnd): constant media
+// exactly, gridded media against their local majorants (the maximum over
+// channels, so the weights stay in [0, 1]).
+Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng) {
+    Color T(1);
+    for (int mi : ctx.scene.regions[size_t(region)].media) {
+        const Medium& m = *ctx.scene.media[size_t(mi)];
+        const Color k = m.sigma_a + m.sigma_s;
+        MediumQuery& q = *ctx.queries[size_t(mi)];
+        float integral;
+        if (q.densityIntegral(r, 0.f, tEnd, integral)) {
+            for (int c = 0; c < 3; ++c)
+                if (integral > 0 && k[c] > 0) T[c] *= std::exp(-k[c] * integral);
+            continue;
+        }
+        const float kMax = maxComponent(k);
+        if (!(kMax > 0)) continue;
+        ctx.scratchSegments.clear();
+        mediumMajorants(ctx, mi, r, tEnd, ctx.scratchSegments);
+        for (const auto& seg : ctx.scratchSegments) {
+            const float sigmaMaj = seg.maxDensity * kMax;
+            if (!(sigmaMaj > 0)) continue;
+            double t = seg.t0;
+            while (true) {
+                t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
+                if (t >= seg.t1) break;
+                ++ctx.counters.shadowSamples;
+                const float d = q.density(r.at(t));
+                for (int c = 0; c < 3; ++c) T[c] *= std::max(0.f, 1 - k[c] * d / sigmaMaj);
+                if (!russianRoulette(T, rng)) return Color(0);
+            }
+        }
+    }
+    return T;
+}
+
+}  // namespace
+
+Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const Vec3& wi, float dist, Rng& rng,
+                          TransmittanceEstimator estimator) {
+    ++ctx.counters.shadowRays;
+    if (estimator == TransmittanceEstimator::RatioTracking) {
+        Color T(1);
+        bool reached = walkShadowRay(ctx.scene, region, Ray{p, wi}, dist, [&](int reg, const Ray& r, float tEnd) {
+            T *= ratioTracking(ctx, reg, r, tEnd, rng);
+            return !isBlack(T);
+        });
+        return reached ? T : Color(0);
+    }
+    Color tau(0);
+    // exp(-30) ~ 1e-13: beyond that depth the light is numerically gone.
+    const float cutoff = 30.f;
+    bool reached = walkShadowRay(ctx.scene, region, Ray{p, wi}, dist, [&](int reg, const Ray& r, float tEnd) {
+        tau += opticalDepth(ctx, reg, r, tEnd, rng, cutoff - minComponent(tau));
+        return !(minComponent(tau) > cutoff);
+    });
+    return reached ? exp(-tau) : Color(0);
+}
+
+}  // namespace vdbmarch
