@@ -67,7 +67,7 @@ BENCHMARK(BM_DensityPaddedBlocks);
 
 // OpenVDB's own trilinear sampler on the same points, for comparison.
 void BM_DensityOpenVdbBoxSampler(benchmark::State& state) {
-    openvdb::initialize();
+    initOpenVdb();
     openvdb::io::File f(kCloud);
     f.open();
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid("density"));

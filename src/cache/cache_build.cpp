@@ -35,18 +35,13 @@ void unpackKey(uint64_t key, int32_t& i, int32_t& j, int32_t& k) {
     k = int32_t((key >> (2 * KeyBits)) & uint64_t(MaxCoord));
 }
 
-bool isFiniteBox(const BBox& b) {
-    return std::isfinite(b.lo.x) && std::isfinite(b.lo.y) && std::isfinite(b.lo.z) && std::isfinite(b.hi.x) &&
-           std::isfinite(b.hi.y) && std::isfinite(b.hi.z);
-}
-
 // Boxes covering the scattering media (unbounded fog: the photon target).
 std::vector<BBox> scatteringBoxes(const Scene& scene) {
     std::vector<BBox> boxes;
     bool unbounded = false;
     for (const auto& m : scene.media) {
         if (m->isVacuum() || isBlack(m->sigma_s)) continue;
-        if (!isFiniteBox(m->worldBounds())) {
+        if (!m->worldBounds().isFinite()) {
             unbounded = true;
             continue;
         }

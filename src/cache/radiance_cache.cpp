@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <mutex>
 
 #include <openvdb/openvdb.h>
 
@@ -14,15 +13,11 @@
 #include "core/hash.h"
 #include "core/error.h"
 #include "core/atomic_file.h"
+#include "volume/medium.h"
 
 namespace vdbmarch {
 
 namespace {
-
-void initOpenVdb() {
-    static std::once_flag once;
-    std::call_once(once, [] { openvdb::initialize(); });
-}
 
 // VDB voxel (i, j, k) of level `level` has its centre at the cell centre.
 openvdb::math::Transform::Ptr levelTransform(const Vec3& origin, float h) {

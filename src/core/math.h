@@ -88,6 +88,8 @@ struct BBox {
     Vec3 lo{Infinity, Infinity, Infinity};
     Vec3 hi{-Infinity, -Infinity, -Infinity};
     bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
+    // False for an unbounded box (infinite fog) and for the empty box.
+    bool isFinite() const { return vdbmarch::isFinite(lo) && vdbmarch::isFinite(hi); }
     void expand(const Vec3& p) { lo = min(lo, p); hi = max(hi, p); }
     void expand(const BBox& b) { lo = min(lo, b.lo); hi = max(hi, b.hi); }
     Vec3 center() const { return (lo + hi) * 0.5f; }

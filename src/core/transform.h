@@ -17,6 +17,18 @@ struct Mat4 {
     Mat4 inverse(const char* what = "transform") const;
     Mat4 transposed() const;
     double det3() const;  // determinant of the linear part
+    // M (x, y, z, 1) and M (v, 0), computed in double, rounded to float.
+    Vec3 point(double x, double y, double z) const {
+        return Vec3(float(m[0][0] * x + m[0][1] * y + m[0][2] * z + m[0][3]),
+                    float(m[1][0] * x + m[1][1] * y + m[1][2] * z + m[1][3]),
+                    float(m[2][0] * x + m[2][1] * y + m[2][2] * z + m[2][3]));
+    }
+    Vec3 point(const Vec3& p) const { return point(p.x, p.y, p.z); }
+    Vec3 vector(const Vec3& v) const {
+        return Vec3(float(m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z),
+                    float(m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z),
+                    float(m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z));
+    }
 };
 
 class Transform {
@@ -25,8 +37,8 @@ public:
     explicit Transform(const Mat4& m, const char* what = "transform") : mM(m), mInv(m.inverse(what)) {}
     Transform(const Mat4& m, const Mat4& inv) : mM(m), mInv(inv) {}
 
-    Vec3 point(const Vec3& p) const { return apply(mM, p, 1); }
-    Vec3 vector(const Vec3& v) const { return apply(mM, v, 0); }
+    Vec3 point(const Vec3& p) const { return mM.point(p); }
+    Vec3 vector(const Vec3& v) const { return mM.vector(v); }
     // Normals transform with the inverse transpose.
     Vec3 normal(const Vec3& n) const {
         return Vec3(float(mInv.m[0][0] * n.x + mInv.m[1][0] * n.y + mInv.m[2][0] * n.z),
@@ -40,11 +52,6 @@ public:
     bool isIdentity() const;
 
 private:
-    static Vec3 apply(const Mat4& m, const Vec3& p, double w) {
-        return Vec3(float(m.m[0][0] * p.x + m.m[0][1] * p.y + m.m[0][2] * p.z + m.m[0][3] * w),
-                    float(m.m[1][0] * p.x + m.m[1][1] * p.y + m.m[1][2] * p.z + m.m[1][3] * w),
-                    float(m.m[2][0] * p.x + m.m[2][1] * p.y + m.m[2][2] * p.z + m.m[2][3] * w));
-    }
     Mat4 mM, mInv;
 };
 

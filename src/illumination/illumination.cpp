@@ -98,8 +98,12 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
         warn(str(options.cacheFile, ": method ", methodName(method), " with render.li = \"", liSourceName(rs.li),
                  "\" does not read the cache; ignored"));
     // Shadow rays compute the direct light; the photon map adds the rest,
-    // which exists only when light may scatter before the last event.
-    rq.indirect = rs.li == LiSource::Photons && rs.maxDepth > 1;
+    // which exists when light may scatter before the last event, or pass
+    // refracting glass (a caustic, even for single scattering).
+    bool bendingGlass = false;
+    for (const SurfaceInfo& s : scene.surfaces)
+        bendingGlass = bendingGlass || (s.material.type == MaterialDesc::Type::Dielectric && s.material.ior != 1.f);
+    rq.indirect = rs.li == LiSource::Photons && (rs.maxDepth > 1 || bendingGlass);
     return rq;
 }
 

@@ -163,9 +163,7 @@ PhotonTarget photonTarget(const Scene& scene) {
     for (const auto& m : scene.media) {
         if (m->isVacuum()) continue;
         BBox b = m->worldBounds();
-        bool bounded = std::isfinite(b.lo.x) && std::isfinite(b.hi.x) && std::isfinite(b.lo.y) &&
-                       std::isfinite(b.hi.y) && std::isfinite(b.lo.z) && std::isfinite(b.hi.z);
-        if (!bounded) {
+        if (!b.isFinite()) {
             if (scatters(*m)) t.unbounded = true;
             continue;
         }

@@ -6,11 +6,10 @@
 #include <mutex>
 
 #include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
-#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "core/threads.h"
 #include "marchers/marcher.h"
 
 namespace vdbmarch {
@@ -65,7 +64,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     std::vector<double> transmittances(size_t(w) * size_t(h), 0.0);
     std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
     ProgressBar progress(options.progress, timed ? 1000 : tiles);
-    const int threads = rs.threads > 0 ? rs.threads : tbb::info::default_concurrency();
+    const int threads = resolveThreadCount(rs.threads);
     result.threads = threads;
     auto start = std::chrono::steady_clock::now();
     auto runStart = options.runStart ? *options.runStart : start;

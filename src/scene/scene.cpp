@@ -37,7 +37,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
                 if (!isInterior[i]) scene->regions[Scene::WorldRegion].unboundedSigmaT += k;
             }
             BBox b = m->worldBounds();
-            if (std::isfinite(b.lo.x) && std::isfinite(b.hi.x)) bounds.expand(b);
+            if (b.isFinite()) bounds.expand(b);
         }
         if (md.hasEmission && isBlack(md.sigma_a))
             warn(str(desc.file, ": media[", i, "] (\"", md.name,

@@ -87,12 +87,21 @@ SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& h, const V
     e.kind = reflect ? SurfaceEvent::Kind::Reflect : SurfaceEvent::Kind::Refract;
     e.straight = !reflect && ior == 1.f;
     e.region = reflect ? region : across;
-    if (mode == TransportMode::Importance && n != ng) {
-        // Adjoint of the shading-normal BSDF: |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|),
-        // wo towards where the photon came from, wi where it goes.
-        const float num = std::fabs(dot(d, n)) * std::fabs(dot(wo, ng));
-        const float den = std::fabs(dot(d, ng)) * std::fabs(dot(wo, n));
-        e.weight = Color(den > 0 ? num / den : 0.f);
+    if (mode == TransportMode::Importance) {
+        float w = 1;
+        if (n != ng) {
+            // Adjoint of the shading-normal BSDF: |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|),
+            // wo towards where the photon came from, wi where it goes.
+            const float num = std::fabs(dot(d, n)) * std::fabs(dot(wo, ng));
+            const float den = std::fabs(dot(d, ng)) * std::fabs(dot(wo, n));
+            w = den > 0 ? num / den : 0.f;
+        }
+        // Camera paths carry basic radiance L / n^2, which refraction leaves
+        // unchanged (their weight is 1 both ways); photons carry flux, so
+        // the radiance they stand for is divided by (eta_t / eta_i)^2 at
+        // every refraction (Veach's thesis, 5.2).
+        if (!reflect) w /= eta * eta;
+        e.weight = Color(w);
     }
     e.ray = Ray{offsetRayOrigin(scene, h.p, h.n, wo), wo};
     return e;

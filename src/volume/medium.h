@@ -109,4 +109,8 @@ VdbGridSummary summarizeVdb(const std::string& file, const std::string& grid);
 // Names and types of every grid in a file ("density (float)", ...).
 std::vector<std::string> listVdbGrids(const std::string& file);
 
+// openvdb::initialize(), once per process: the library calls it before it
+// reads or writes VDB files, and so does any code that uses OpenVDB directly.
+void initOpenVdb();
+
 }  // namespace vdbmarch

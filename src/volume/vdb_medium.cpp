@@ -2,6 +2,7 @@
 // space, and empty-space skipping with OpenVDB's hierarchical DDA over a
 // dilated copy of the active topology. One of the few files that include
 // OpenVDB headers.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -14,8 +15,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
-
 #include "core/error.h"
 #include "core/transform.h"
 #include "volume/medium.h"
@@ -23,17 +22,17 @@
 
 namespace vdbmarch {
 
+void initOpenVdb() {
+    static std::once_flag once;
+    std::call_once(once, [] { openvdb::initialize(); });
+}
+
 namespace {
 
 using FloatTree = openvdb::FloatTree;
 using LeafT = FloatTree::LeafNodeType;
 using BoolTree = openvdb::BoolTree;
 using VdbRay = openvdb::math::Ray<double>;
-
-void initOpenVdb() {
-    static std::once_flag once;
-    std::call_once(once, [] { openvdb::initialize(); });
-}
 
 std::string gridTypeName(const openvdb::GridBase& g) {
     std::string t = g.valueType();
@@ -316,10 +315,7 @@ public:
             for (int i = 0; i < 8; ++i) {
                 Vec3 corner(float(i & 1 ? mIndexHi.x() : mIndexLo.x()), float(i & 2 ? mIndexHi.y() : mIndexLo.y()),
                             float(i & 4 ? mIndexHi.z() : mIndexLo.z()));
-                Vec3 w(float(i2w.m[0][0] * corner.x + i2w.m[0][1] * corner.y + i2w.m[0][2] * corner.z + i2w.m[0][3]),
-                       float(i2w.m[1][0] * corner.x + i2w.m[1][1] * corner.y + i2w.m[1][2] * corner.z + i2w.m[1][3]),
-                       float(i2w.m[2][0] * corner.x + i2w.m[2][1] * corner.y + i2w.m[2][2] * corner.z + i2w.m[2][3]));
-                mWorldBounds.expand(w);
+                mWorldBounds.expand(i2w.point(corner));
             }
         if (d.hasEmission) {
             const std::string ewhat = str(d.file, ": emission grid '", d.emissionGrid, "'");
@@ -359,11 +355,7 @@ private:
 BBox worldBoxOf(const Mat4& i2w, const openvdb::Vec3d& lo, const openvdb::Vec3d& hi) {
     BBox b;
     for (int i = 0; i < 8; ++i) {
-        double c[3] = {i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()};
-        Vec3 w;
-        for (int r = 0; r < 3; ++r)
-            w[r] = float(i2w.m[r][0] * c[0] + i2w.m[r][1] * c[1] + i2w.m[r][2] * c[2] + i2w.m[r][3]);
-        b.expand(w);
+        b.expand(i2w.point(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()));
     }
     return b;
 }
@@ -396,10 +388,7 @@ public:
                                            openvdb::tools::EXPAND_TILES);
         auto acc = grid.getConstAccessor();
         auto dens = m.mDensity->getConstAccessor();
-        double det = std::fabs(mI2W.m[0][0] * (mI2W.m[1][1] * mI2W.m[2][2] - mI2W.m[1][2] * mI2W.m[2][1]) -
-                               mI2W.m[0][1] * (mI2W.m[1][0] * mI2W.m[2][2] - mI2W.m[1][2] * mI2W.m[2][0]) +
-                               mI2W.m[0][2] * (mI2W.m[1][0] * mI2W.m[2][1] - mI2W.m[1][1] * mI2W.m[2][0]));
-        mVoxelVolume = float(det);
+        mVoxelVolume = float(std::fabs(mI2W.det3()));
         double total = 0, estimate = 0;
         for (auto it = topology.cbeginValueOn(); it; ++it) {
             openvdb::Coord c = it.getCoord();
@@ -413,9 +402,7 @@ public:
             mCdf.push_back(total);
             // Density at the cell centre, for the power estimate only.
             openvdb::Vec3d centre(c.x() + 0.5, c.y() + 0.5, c.z() + 0.5);
-            Vec3 wc;
-            for (int r = 0; r < 3; ++r)
-                wc[r] = float(mI2W.m[r][0] * centre[0] + mI2W.m[r][1] * centre[1] + mI2W.m[r][2] * centre[2] + mI2W.m[r][3]);
+            Vec3 wc = mI2W.point(centre.x(), centre.y(), centre.z());
             float rho = sampleTrilinear(dens, m.mW2I.point(wc)) * m.mScale;
             estimate += double(rho) * sampleTrilinear(acc, centre);
         }
@@ -430,9 +417,7 @@ public:
         size_t i = size_t(std::lower_bound(mCdf.begin(), mCdf.end(), double(u[0])) - mCdf.begin());
         i = std::min(i, mCdf.size() - 1);
         const openvdb::Coord& c = mCoords[i];
-        double q[3] = {c.x() + double(u[1]), c.y() + double(u[2]), c.z() + double(u[3])};
-        for (int r = 0; r < 3; ++r)
-            p[r] = float(mI2W.m[r][0] * q[0] + mI2W.m[r][1] * q[1] + mI2W.m[r][2] * q[2] + mI2W.m[r][3]);
+        p = mI2W.point(c.x() + double(u[1]), c.y() + double(u[2]), c.z() + double(u[3]));
         pdf = mWeights[i] / mVoxelVolume;
     }
 

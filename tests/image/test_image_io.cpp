@@ -1,59 +1,32 @@
-#include "core/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/image.h"
 #include "image/metrics.h"
 #include "image/png_io.h"
+#include "support/support.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <limits>
-#include <sstream>
+#include <set>
 #include <string>
 #include <vector>
 
-namespace fs = std::filesystem;
 using namespace vdbmarch;
+using test::errorOf;
+using test::readBytes;
+using test::writeText;
 
 namespace {
 
-class ImageIoTest : public testing::Test {
+class ImageIoTest : public ::testing::Test {
 protected:
-    void SetUp() override {
-        std::string pattern = (fs::path(testing::TempDir()) / "vdbmarch_image_XXXXXX").string();
-        std::vector<char> buf(pattern.begin(), pattern.end());
-        buf.push_back('\0');
-        ASSERT_NE(mkdtemp(buf.data()), nullptr) << std::strerror(errno);
-        mDir = buf.data();
-    }
-    void TearDown() override {
-        std::error_code ec;
-        fs::remove_all(mDir, ec);
-    }
+    std::string path(const std::string& name) const { return mDir / name; }
+    std::set<std::string> listDir() const { return test::listDir(mDir.path()); }
 
-    std::string path(const std::string& name) const { return (fs::path(mDir) / name).string(); }
-
-    std::vector<std::string> listDir() const {
-        std::vector<std::string> names;
-        for (const auto& e : fs::directory_iterator(mDir)) names.push_back(e.path().filename().string());
-        return names;
-    }
-
-    static void writeText(const std::string& p, const std::string& text) {
-        std::ofstream(p, std::ios::binary) << text;
-    }
-    static std::string readText(const std::string& p) {
-        std::ifstream in(p, std::ios::binary);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        return ss.str();
-    }
-
-    std::string mDir;
+    test::TempDir mDir{"image"};
 };
 
 // Values that stress float exactness: denormals, huge, negative, non-finite.
@@ -104,7 +77,7 @@ TEST_F(ImageIoTest, ExrRoundTripIsBitExactWithAttributes) {
     StringAttributes read = readExrStringAttributes(path("a.exr"));
     std::sort(attrs.begin(), attrs.end());
     EXPECT_EQ(read, attrs);  // sorted by name, and no other string attributes
-    EXPECT_EQ(listDir(), std::vector<std::string>{"a.exr"});  // no temp file left
+    EXPECT_EQ(listDir(), std::set<std::string>{"a.exr"});  // no temp file left
 }
 
 TEST_F(ImageIoTest, ExrWriteReplacesExistingFile) {
@@ -120,36 +93,21 @@ TEST_F(ImageIoTest, ExrWriteReplacesExistingFile) {
 
 TEST_F(ImageIoTest, ReadExrMissingFileNamesIt) {
     std::string p = path("missing.exr");
-    try {
-        readExr(p);
-        FAIL() << "expected IoError";
-    } catch (const IoError& e) {
-        EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
-    }
+    EXPECT_CONTAINS(errorOf<IoError>([&] { readExr(p); }), p);
     EXPECT_THROW(readExrStringAttributes(p), IoError);
 }
 
 TEST_F(ImageIoTest, ReadExrOfNonExrFileNamesIt) {
     std::string p = path("text.exr");
     writeText(p, "this is not an OpenEXR file\n");
-    try {
-        readExr(p);
-        FAIL() << "expected InputError";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
-    }
+    EXPECT_CONTAINS(errorOf<InputError>([&] { readExr(p); }), p);
 }
 
 TEST_F(ImageIoTest, ReadExrOfTruncatedFileThrowsInputError) {
     writeExr(path("a.exr"), makeTestImage(64, 64), {});
-    std::string bytes = readText(path("a.exr"));
+    std::string bytes = readBytes(path("a.exr"));
     writeText(path("cut.exr"), bytes.substr(0, bytes.size() / 2));
-    try {
-        readExr(path("cut.exr"));
-        FAIL() << "expected InputError";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(path("cut.exr")), std::string::npos) << e.what();
-    }
+    EXPECT_CONTAINS(errorOf<InputError>([&] { readExr(path("cut.exr")); }), path("cut.exr"));
 }
 
 TEST_F(ImageIoTest, ExrRejectsReservedAttributeWithoutTouchingExistingFile) {
@@ -157,80 +115,14 @@ TEST_F(ImageIoTest, ExrRejectsReservedAttributeWithoutTouchingExistingFile) {
     EXPECT_THROW(writeExr(path("keep.exr"), makeTestImage(2, 2), {{"compression", "none"}}), InputError);
     EXPECT_THROW(writeExr(path("keep.exr"), makeTestImage(2, 2), {{"a", "1"}, {"a", "2"}}), InputError);
     EXPECT_THROW(writeExr(path("keep.exr"), Image(), {}), InputError);
-    EXPECT_EQ(readText(path("keep.exr")), "old contents");
-    EXPECT_EQ(listDir(), std::vector<std::string>{"keep.exr"});
+    EXPECT_EQ(readBytes(path("keep.exr")), "old contents");
+    EXPECT_EQ(listDir(), std::set<std::string>{"keep.exr"});
 }
 
 TEST_F(ImageIoTest, WriteIntoMissingDirectoryThrowsIoError) {
     std::string p = path("no/such/dir/a.exr");
-    try {
-        writeExr(p, makeTestImage(2, 2), {});
-        FAIL() << "expected IoError";
-    } catch (const IoError& e) {
-        EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
-    }
+    EXPECT_CONTAINS(errorOf<IoError>([&] { writeExr(p, makeTestImage(2, 2), {}); }), p);
     EXPECT_THROW(writePng(path("no/such/dir/a.png"), makeTestImage(2, 2)), IoError);
-}
-
-TEST_F(ImageIoTest, UncommittedAtomicFileLeavesNoFile) {
-    std::string tmp;
-    {
-        AtomicFile file(path("out.exr"));
-        tmp = file.tempPath();
-        EXPECT_EQ(fs::path(tmp).parent_path(), fs::path(mDir));
-        EXPECT_NE(tmp, path("out.exr"));
-        writeText(tmp, "partial");
-        ASSERT_TRUE(fs::exists(tmp));
-    }
-    EXPECT_FALSE(fs::exists(tmp));
-    EXPECT_FALSE(fs::exists(path("out.exr")));
-    EXPECT_TRUE(listDir().empty());
-}
-
-TEST_F(ImageIoTest, UncommittedAtomicFileDoesNotClobberExisting) {
-    writeText(path("out.txt"), "old");
-    {
-        AtomicFile file(path("out.txt"));
-        writeText(file.tempPath(), "new");
-    }
-    EXPECT_EQ(readText(path("out.txt")), "old");
-    EXPECT_EQ(listDir(), std::vector<std::string>{"out.txt"});
-}
-
-TEST_F(ImageIoTest, CommittedAtomicFileReplacesExisting) {
-    writeText(path("out.txt"), "old");
-    AtomicFile a(path("out.txt")), b(path("out.txt"));
-    EXPECT_NE(a.tempPath(), b.tempPath());  // concurrent writers do not collide
-    writeText(a.tempPath(), "new");
-    a.commit();
-    EXPECT_EQ(readText(path("out.txt")), "new");
-    EXPECT_FALSE(fs::exists(a.tempPath()));
-}
-
-TEST_F(ImageIoTest, CommitWithoutTempFileThrowsNamingPath) {
-    AtomicFile file(path("never.txt"));
-    try {
-        file.commit();
-        FAIL() << "expected IoError";
-    } catch (const IoError& e) {
-        EXPECT_NE(std::string(e.what()).find(path("never.txt")), std::string::npos) << e.what();
-    }
-    EXPECT_FALSE(fs::exists(path("never.txt")));
-}
-
-TEST_F(ImageIoTest, CheckWritable) {
-    EXPECT_NO_THROW(checkWritable(path("new.exr")));
-    writeText(path("existing.exr"), "x");
-    EXPECT_NO_THROW(checkWritable(path("existing.exr")));
-    EXPECT_THROW(checkWritable(path("missing/new.exr")), IoError);
-    EXPECT_THROW(checkWritable(path("existing.exr/new.exr")), IoError);  // parent is a file
-    fs::create_directory(path("sub"));
-    EXPECT_THROW(checkWritable(path("sub")), IoError);  // target is a directory
-    try {
-        checkWritable(path("missing/new.exr"));
-    } catch (const IoError& e) {
-        EXPECT_NE(std::string(e.what()).find(path("missing/new.exr")), std::string::npos) << e.what();
-    }
 }
 
 TEST_F(ImageIoTest, PngRoundTripWithinQuantisation) {
@@ -250,7 +142,7 @@ TEST_F(ImageIoTest, PngRoundTripWithinQuantisation) {
                 EXPECT_NEAR(got, want, 0.5f / 255.f + 1e-5f) << x << "," << y << "," << c;
             }
     EXPECT_EQ(back.alpha(3, 3), 1.f);
-    EXPECT_EQ(listDir(), std::vector<std::string>{"a.png"});
+    EXPECT_EQ(listDir(), std::set<std::string>{"a.png"});
 }
 
 TEST_F(ImageIoTest, PngExposureClampAndNonFinite) {
@@ -273,12 +165,7 @@ TEST_F(ImageIoTest, PngExposureClampAndNonFinite) {
 TEST_F(ImageIoTest, ReadPngErrors) {
     EXPECT_THROW(readPng(path("missing.png")), IoError);
     writeText(path("bad.png"), "not a png");
-    try {
-        readPng(path("bad.png"));
-        FAIL() << "expected InputError";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(path("bad.png")), std::string::npos) << e.what();
-    }
+    EXPECT_CONTAINS(errorOf<InputError>([&] { readPng(path("bad.png")); }), path("bad.png"));
 }
 
 TEST(SrgbCurve, InverseAndEndpoints) {
@@ -320,14 +207,7 @@ TEST(Metrics, ConstantOffsetGivesExactErrors) {
 }
 
 TEST(Metrics, SizeMismatchThrowsWithBothSizes) {
-    try {
-        compareImages(Image(4, 3), Image(3, 4));
-        FAIL() << "expected InputError";
-    } catch (const InputError& e) {
-        std::string msg = e.what();
-        EXPECT_NE(msg.find("4x3"), std::string::npos) << msg;
-        EXPECT_NE(msg.find("3x4"), std::string::npos) << msg;
-    }
+    test::expectErrorContaining<InputError>([] { compareImages(Image(4, 3), Image(3, 4)); }, {"4x3", "3x4"});
 }
 
 TEST(Metrics, NonFinitePixelsAreCountedAndExcluded) {

@@ -7,10 +7,12 @@
 #include <cstring>
 
 #include "core/sampling.h"
-#include "test_helpers.h"
+#include "support/support.h"
 
-namespace vdbmarch::testing {
+namespace vdbmarch {
 namespace {
+
+using namespace test;
 
 std::string orthoCamera(float width, int res, float z = 5) {
     return str(R"("camera": {"type": "orthographic", "position": [0.475, 0.475, )", z,
@@ -35,8 +37,8 @@ TEST(AnalyticMarcher, HomogeneousSlabTransmittanceIsBeerLambert) {
 // trilinear hat functions form a partition of unity, so the samples' density
 // sum is exactly the voxel count for any random offset.
 TEST(AnalyticMarcher, VdbBoxTransmittanceIsExactAtOneVoxelStep) {
-    std::string vdb = tempDir() + "/box20.vdb";
-    writeBoxGrid(vdb, openvdb::Coord(0), openvdb::Coord(19), 1.f, 0.05);
+    TempDir dir;
+    std::string vdb = writeBoxGrid(dir / "box20.vdb", 0, 19, 1.f, 0.05);
     auto scene = sceneFromJson("{" + orthoCamera(0.5f, 16) + R"(,
         "media": [{"type": "vdb", "file": ")" + vdb + R"(", "sigma_a": [2, 2, 2], "sigma_s": 0}],
         "render": {"seed": 5}})");
@@ -53,8 +55,8 @@ TEST(AnalyticMarcher, VdbBoxTransmittanceIsExactAtOneVoxelStep) {
 // Pure emission (sigma_s = 0): the per-step terms telescope, so
 // L = scale * color * (1 - exp(-sigma_a * thickness)) exactly.
 TEST(AnalyticMarcher, EmissionOfAbsorbingBoxIsExact) {
-    std::string vdb = tempDir() + "/emissive.vdb";
-    writeEmissiveBox(vdb);
+    TempDir dir;
+    std::string vdb = writeEmissiveBox(dir / "emissive.vdb");
     auto scene = sceneFromJson("{" + orthoCamera(0.5f, 8) + R"(,
         "media": [{"type": "vdb", "file": ")" + vdb + R"(", "sigma_a": [1.5, 1.5, 1.5], "sigma_s": 0,
                    "emission": {"grid": "temperature", "scale": 2, "color": [1, 0.5, 0.25]}}],
@@ -76,19 +78,19 @@ TEST(AnalyticMarcher, EmissionOfAbsorbingBoxIsExact) {
 // The random offset makes pixels vary; the test bound is 4 standard errors of
 // the pixel mean plus the O((sigma_t dx)^2) discretisation bias of eq. 5 with
 // S of eq. 7 (first-order terms of S and of the transmittance cancel).
-class SingleScatteringSlab : public ::testing::TestWithParam<std::tuple<float, std::string>> {};
+class SingleScatteringSlab : public ::testing::TestWithParam<std::tuple<float, Method>> {};
 
 TEST_P(SingleScatteringSlab, MatchesClosedForm) {
     const float g = std::get<0>(GetParam());
-    const std::string method = std::get<1>(GetParam());
+    const Method method = std::get<1>(GetParam());
     const double sigmaS = 0.8, sigmaT = 1.0, d = 1.0, theta = radians(40.f), E = 1.0;
     const double mu = std::cos(theta);
     auto scene = sceneFromJson("{" + orthoCamera(0.5f, 64) + str(R"(,
         "lights": [{"type": "directional", "direction": [0, )", -std::sin(theta), ", ", -mu, R"(], "irradiance": 1}],
         "media": [{"type": "homogeneous", "sigma_a": 0.2, "sigma_s": 0.8, "g": )", g, R"(,
                    "bounds": {"min": [-10, -10, -0.5], "max": [10, 10, 0.5]}}],
-        "render": {"step": 0.01, "seed": 11, "max_depth": 1, "method": ")", method, R"(",
-                   "spp": )", method == "uniform" ? 1 : 16, "}}"));
+        "render": {"step": 0.01, "seed": 11, "max_depth": 1, "method": ")", methodName(method), R"(",
+                   "spp": )", method == Method::Uniform ? 1 : 16, "}}"));
     RenderResult r = renderImage(*scene);
     // Phase argument: cos between the light's travel direction and the view ray's.
     double p = hgPhase(float(-mu), g);
@@ -97,28 +99,27 @@ TEST_P(SingleScatteringSlab, MatchesClosedForm) {
     for (int c = 0; c < 3; ++c) {
         ChannelStats s = pixelStats(r.image, c);
         double tol = 4 * s.stdError + 2e-4 * expected;
-        EXPECT_NEAR(s.mean, expected, tol) << "g=" << g << " channel " << c;
+        EXPECT_NEAR(s.mean, expected, tol) << methodName(method) << " g=" << g << " channel " << c;
     }
 }
 
 INSTANTIATE_TEST_SUITE_P(Anisotropy, SingleScatteringSlab,
-                         ::testing::Combine(::testing::Values(0.f, 0.9f, -0.9f),
-                                            ::testing::Values(std::string("uniform"), std::string("transmittance"),
-                                                              std::string("guided"), std::string("reference"))),
+                         ::testing::Combine(::testing::Values(0.f, 0.9f, -0.9f), ::testing::ValuesIn(marcherMethods())),
                          [](const auto& info) {
                              float g = std::get<0>(info.param);
-                             return std::get<1>(info.param) + (g == 0 ? "_g0" : (g > 0 ? "_gPlus09" : "_gMinus09"));
+                             return std::string(methodName(std::get<1>(info.param))) +
+                                    (g == 0 ? "_g0" : (g > 0 ? "_gPlus09" : "_gMinus09"));
                          });
 
 // The same scene and seed give bit-identical pixels for any thread count,
 // for every method (photon tracing and the cache build included: max_depth 3).
-class Determinism : public ::testing::TestWithParam<std::string> {};
+class Determinism : public ::testing::TestWithParam<Method> {};
 
 TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
-    std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
+    std::string scenePath = samplePath("cloud.json");
     auto render = [&](int threads) {
         SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[40,30]", "render.spp=2", "render.max_depth=3",
-                                                "photons.count=20000", "render.method=\"" + GetParam() + "\"",
+                                                "photons.count=20000", methodOverride(GetParam()),
                                                 str("render.threads=", threads)});
         return renderImage(*buildScene(d));
     };
@@ -132,21 +133,14 @@ TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
     EXPECT_GT(sum, 0);  // the cloud is lit: not a trivially black image
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, Determinism,
-                         ::testing::Values(std::string("uniform"), std::string("transmittance"), std::string("guided"),
-                                           std::string("reference")));
+INSTANTIATE_TEST_SUITE_P(Methods, Determinism, ::testing::ValuesIn(marcherMethods()), methodParamName);
 
 // Work grows with active voxels, not with the bounding box: a far-away extra
 // voxel that inflates the bbox 50x leaves the march sample count unchanged.
 TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
-    std::string small = tempDir() + "/blob.vdb", large = tempDir() + "/blob_far.vdb";
-    writeBoxGrid(small, openvdb::Coord(0), openvdb::Coord(9), 0.5f, 0.05);
-    {
-        auto grid = makeBoxGrid(openvdb::Coord(0), openvdb::Coord(9), 0.5f, 0.05);
-        grid->tree().setValue(openvdb::Coord(-500, -500, -500), 0.5f);
-        grid->tree().setValue(openvdb::Coord(500, 500, 500), 0.5f);
-        openvdb::io::File(large).write({grid});
-    }
+    TempDir dir;
+    std::string small = writeBoxGrid(dir / "blob.vdb", 0, 9, 0.5f, 0.05);
+    std::string large = writeBoxGrid(dir / "blob_far.vdb", 0, 9, 0.5f, 0.05, "density", {Index3(-500), Index3(500)});
     auto run = [&](const std::string& file) {
         auto scene = sceneFromJson(R"({"camera": {"type": "perspective", "position": [0.5, 0.4, 3], "look_at": [0.225, 0.225, 0.225],
             "fov_deg": 20, "resolution": [24, 24]},
@@ -160,20 +154,14 @@ TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
     EXPECT_EQ(a.shadowSamples, b.shadowSamples);
 }
 
-}  // namespace
-}  // namespace vdbmarch::testing
-
-namespace vdbmarch::testing {
-namespace {
-
 // A time budget renders whole passes of one sample per pixel; the image is the
 // same, bit for bit, as a render of that many samples per pixel (for guided,
 // the cache lookups along a ray must not depend on earlier rays).
-class TimeBudget : public ::testing::TestWithParam<std::string> {};
+class TimeBudget : public ::testing::TestWithParam<Method> {};
 
 TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
-    std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
-    SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]", "render.method=\"" + GetParam() + "\""});
+    std::string scenePath = samplePath("cloud.json");
+    SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]", methodOverride(GetParam())});
     auto scene = buildScene(d);
     RenderOptions timed;
     timed.timeBudget = 0.5;
@@ -185,14 +173,7 @@ TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
     EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), b.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget,
-                         ::testing::Values(std::string("uniform"), std::string("guided")));
-
-}  // namespace
-}  // namespace vdbmarch::testing
-
-namespace vdbmarch::testing {
-namespace {
+INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget, ::testing::ValuesIn(marcherMethods()), methodParamName);
 
 std::string furnaceScene(const std::string& sigmaS) {
     return R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_deg": 40, "resolution": [24, 24]},
@@ -219,8 +200,8 @@ TEST(Reference, FurnaceWithAlbedoOneIsFlatAtTheBackground) {
 // Transmittance through a VDB box: the reference's alpha is the fraction of
 // paths that scattered or were absorbed, whose expectation is 1 - T.
 TEST(Reference, VdbBoxAlphaIsBeerLambertInExpectation) {
-    std::string vdb = tempDir() + "/refbox.vdb";
-    writeBoxGrid(vdb, openvdb::Coord(0), openvdb::Coord(19), 1.f, 0.05);
+    TempDir dir;
+    std::string vdb = writeBoxGrid(dir / "refbox.vdb", 0, 19, 1.f, 0.05);
     auto scene = sceneFromJson(R"({"camera": {"type": "orthographic", "position": [0.475, 0.475, 5],
         "look_at": [0.475, 0.475, 0], "width_world": 0.5, "resolution": [32, 32]},
         "media": [{"type": "vdb", "file": ")" + vdb + R"(", "sigma_a": 0.6, "sigma_s": 0.4}],
@@ -237,7 +218,7 @@ TEST(Reference, VdbBoxAlphaIsBeerLambertInExpectation) {
 // within 4 standard errors (paired) plus the marcher's O((kappa dx)^2) bias
 // (well under 0.5%).
 TEST(Reference, AgreesWithTheUniformMarcherForSingleScattering) {
-    std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
+    std::string scenePath = samplePath("cloud.json");
     std::vector<std::string> common = {"camera.resolution=[32,24]", "render.max_depth=1",
         R"(surfaces=[{"shape": "sphere", "transform": {"scale": 0.35, "translate": [0.6, 0.45, 1.2]}, "material": {"type": "dielectric", "ior": 1.5}}])"};
     auto render = [&](const std::string& method, int spp) {
@@ -265,19 +246,13 @@ TEST(Reference, AgreesWithTheUniformMarcherForSingleScattering) {
     }
 }
 
-}  // namespace
-}  // namespace vdbmarch::testing
-
-namespace vdbmarch::testing {
-namespace {
-
 // Convergence: the reference is unbiased with finite variance, so its MSE
 // against a high-sample image falls as 1/spp: doubling spp divides it by
 // (1/n + 1/N) / (1/(2n) + 1/N) (N: the high image's spp, whose own noise adds
 // 1/N). The ratio's tolerance is 4 standard errors from the measured spread of
 // the per-pixel squared errors (delta method).
 TEST(Reference, MseHalvesWhenSamplesDouble) {
-    std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
+    std::string scenePath = samplePath("cloud.json");
     auto render = [&](int spp, int seed) {
         SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[32,24]", "render.method=reference",
                                                 "render.max_depth=4", str("render.spp=", spp), str("render.seed=", seed)});
@@ -309,54 +284,43 @@ TEST(Reference, MseHalvesWhenSamplesDouble) {
     std::printf("MSE %g -> %g, ratio %g (expected %g, relative SE %g)\n", mseA, mseB, ratio, expected, relSe);
 }
 
-}  // namespace
-}  // namespace vdbmarch::testing
-
-namespace vdbmarch::testing {
-namespace {
-
 // Single scattering in a VDB box lit and seen along the grid's z axis
 // (backscatter, cos = -1). Camera and light paths cross the same density, so
 // with u = ∫ rho dz the integral becomes ∫ exp(-2 sigma_t u) du whatever the
 // trilinear ramps at the faces: L = sigma_s p(-1) E (1 - exp(-2 sigma_t N h)) /
 // (2 sigma_t). For the reference this checks delta tracking and ratio tracking
-// against local VDB majorants; for the marcher, trilinear sampling and shadow
-// marching. Bound: 4 standard errors plus the marcher's O((kappa dx)^2) bias.
-class VdbSingleScattering : public ::testing::TestWithParam<std::string> {};
+// against local VDB majorants; for the marchers, trilinear sampling and shadow
+// marching. Bound: 4 standard errors plus the marchers' O((kappa dx)^2) bias.
+class VdbSingleScattering : public ::testing::TestWithParam<Method> {};
 
 TEST_P(VdbSingleScattering, MatchesClosedFormAlongTheAxis) {
-    std::string vdb = tempDir() + "/ss_box.vdb";
-    writeBoxGrid(vdb, openvdb::Coord(0, 0, 0), openvdb::Coord(39, 39, 19), 0.5f, 0.05);
+    TempDir dir;
+    std::string vdb = writeBoxGrid(dir / "ss_box.vdb", {0, 0, 0}, {39, 39, 19}, 0.5f, 0.05);
     const double sigmaS = 3, sigmaA = 1, g = 0.5, E = 2, Nh = 20 * 0.05 * 0.5;  // density 0.5
-    const bool reference = GetParam() == "reference";
+    // The uniform marcher's pixels vary only by the random offset; the
+    // reference's by whole paths; the other marchers' by their sampled steps.
+    const int spp = GetParam() == Method::Uniform ? 2 : GetParam() == Method::Reference ? 64 : 16;
     auto scene = sceneFromJson(str(R"({"camera": {"type": "orthographic", "position": [0.975, 0.975, 3],
         "look_at": [0.975, 0.975, 0], "width_world": 0.6, "resolution": [32, 32]},
         "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": )", E, R"(}],
         "media": [{"type": "vdb", "file": ")", vdb, R"(", "sigma_a": )", sigmaA, R"(, "sigma_s": )", sigmaS,
         R"(, "g": )", g, R"(}],
-        "render": {"method": ")", GetParam(), R"(", "max_depth": 1, "spp": )", reference ? 64 : 2,
+        "render": {"method": ")", methodName(GetParam()), R"(", "max_depth": 1, "spp": )", spp,
         R"(, "step": 0.005, "seed": 21}})"));
     RenderResult r = renderImage(*scene);
     const double sigmaT = sigmaS + sigmaA;
     const double expected = sigmaS * hgPhase(-1.f, float(g)) * E * (1 - std::exp(-2 * sigmaT * Nh)) / (2 * sigmaT);
     ChannelStats s = pixelStats(r.image, 0);
-    EXPECT_NEAR(s.mean, expected, 4 * s.stdError + 1e-3 * expected) << GetParam();
+    EXPECT_NEAR(s.mean, expected, 4 * s.stdError + 1e-3 * expected) << methodName(GetParam());
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, VdbSingleScattering,
-                         ::testing::Values(std::string("uniform"), std::string("reference")));
-
-}  // namespace
-}  // namespace vdbmarch::testing
-
-namespace vdbmarch::testing {
-namespace {
+INSTANTIATE_TEST_SUITE_P(Methods, VdbSingleScattering, ::testing::ValuesIn(marcherMethods()), methodParamName);
 
 // The reference's emission estimator (sigma_a L_e / sigma_maj at tentative
 // collisions) against the closed form of an absorbing, emitting VDB box.
 TEST(Reference, EmissionOfAbsorbingBoxMatchesClosedForm) {
-    std::string vdb = tempDir() + "/emissive_ref.vdb";
-    writeEmissiveBox(vdb);
+    TempDir dir;
+    std::string vdb = writeEmissiveBox(dir / "emissive_ref.vdb");
     auto scene = sceneFromJson(R"({"camera": {"type": "orthographic", "position": [0.475, 0.475, 5],
         "look_at": [0.475, 0.475, 0], "width_world": 0.5, "resolution": [32, 32]},
         "media": [{"type": "vdb", "file": ")" + vdb + R"(", "sigma_a": [1.5, 1.5, 1.5], "sigma_s": 0,
@@ -373,7 +337,7 @@ TEST(Reference, EmissionOfAbsorbingBoxMatchesClosedForm) {
 
 // The reference is deterministic for any thread count too.
 TEST(Reference, ImageIsIdenticalForAnyThreadCount) {
-    std::string scenePath = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/glass.json";
+    std::string scenePath = samplePath("glass.json");
     auto render = [&](int threads) {
         SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[32,24]", "render.spp=2", "render.method=reference",
                                                 "render.max_depth=8", str("render.threads=", threads)});
@@ -388,4 +352,4 @@ TEST(Reference, ImageIsIdenticalForAnyThreadCount) {
 }
 
 }  // namespace
-}  // namespace vdbmarch::testing
+}  // namespace vdbmarch

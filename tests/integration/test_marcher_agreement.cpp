@@ -13,11 +13,14 @@
 #include <cstdlib>
 
 #include "core/error.h"
+#include "marchers/marcher.h"
 #include "render/render.h"
-#include "test_helpers.h"
+#include "support/support.h"
 
-namespace vdbmarch::testing {
+namespace vdbmarch {
 namespace {
+
+using namespace test;
 
 struct Agreement {
     double meanDiff = 0, stdError = 0, mean = 0, relMse = 0;
@@ -46,28 +49,44 @@ Agreement compare(const Image& test, const Image& ref) {
     return a;
 }
 
-Image render(const std::string& sceneFile, const std::vector<std::string>& common, const std::string& method, int spp) {
+Image render(const std::string& sceneFile, const std::vector<std::string>& common, Method method, int spp) {
     std::vector<std::string> o = common;
-    o.push_back("render.method=\"" + method + "\"");
+    o.push_back(methodOverride(method));
     o.push_back(str("render.spp=", spp));
     return renderImage(*buildScene(loadSceneFile(sceneFile, o))).image;
 }
 
+// Every marcher against the reference: the uniform marcher at a small step
+// (its bias is O((kappa dx)^2)) and 4 spp, the ray-pdf marchers (and any new
+// method) at 32 spp.
+struct Run {
+    Method method;
+    int spp;
+    std::vector<std::string> extra;
+};
+
+std::vector<Run> marcherRuns() {
+    std::vector<Run> runs;
+    for (Method m : marcherMethods()) {
+        if (m == Method::Reference) continue;
+        if (m == Method::Uniform) runs.push_back({m, 4, {"render.step=0.01"}});
+        else runs.push_back({m, 32, {}});
+    }
+    return runs;
+}
+
 void checkAgreement(const std::string& name, const std::string& sceneFile, const std::vector<std::string>& common,
                     int referenceSpp, double photonBias) {
-    Image ref = render(sceneFile, common, "reference", referenceSpp);
-    struct Run {
-        const char* method;
-        int spp;
-        std::vector<std::string> extra;
-    } runs[] = {{"uniform", 4, {"render.step=0.01"}}, {"transmittance", 32, {}}, {"guided", 32, {}}};
+    Image ref = render(sceneFile, common, Method::Reference, referenceSpp);
+    const std::vector<Run> runs = marcherRuns();
+    ASSERT_GE(runs.size(), 3u);
     for (const auto& run : runs) {
         std::vector<std::string> o = common;
         o.insert(o.end(), run.extra.begin(), run.extra.end());
         Agreement a = compare(render(sceneFile, o, run.method, run.spp), ref);
-        EXPECT_NEAR(a.meanDiff, 0.0, 4 * a.stdError + photonBias * a.mean) << name << ": " << run.method;
+        EXPECT_NEAR(a.meanDiff, 0.0, 4 * a.stdError + photonBias * a.mean) << name << ": " << methodName(run.method);
         if (std::getenv("VDBMARCH_VERBOSE"))
-            std::printf("%s %s: mean diff %.4g (%.2f%% of mean %.4g), SE %.3g, relMSE %.4g\n", name.c_str(), run.method,
+            std::printf("%s %s: mean diff %.4g (%.2f%% of mean %.4g), SE %.3g, relMSE %.4g\n", name.c_str(), methodName(run.method),
                         a.meanDiff, 100 * a.meanDiff / a.mean, a.mean, a.stdError, a.relMse);
     }
 }
@@ -82,7 +101,7 @@ void checkAgreement(const std::string& name, const std::string& sceneFile, const
 constexpr double PhotonBias = 0.03;
 
 TEST(MarcherAgreement, VdbCloudUnderASpotlight) {
-    const std::string scene = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.json";
+    const std::string scene = samplePath("cloud.json");
     checkAgreement("cloud+spot", scene,
                    {"camera.resolution=[32,24]", "render.max_depth=4", "render.seed=3",
                     R"(media=[{"name": "cloud", "type": "vdb", "file": "cloud.vdb", "sigma_a": 0.3, "sigma_s": 6, "g": 0.6}])",
@@ -93,7 +112,7 @@ TEST(MarcherAgreement, VdbCloudUnderASpotlight) {
 }
 
 TEST(MarcherAgreement, GlassSphereWithSmokeUnderASphereLight) {
-    const std::string scene = std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/glass.json";
+    const std::string scene = samplePath("glass.json");
     checkAgreement("glass+sphere light", scene,
                    {"camera.resolution=[32,24]", "render.max_depth=4", "render.seed=3",
                     R"(lights=[{"type": "sphere", "position": [-1.0, 1.6, 0.8], "radius": 0.25, "power": [60, 55, 50]}])"
@@ -104,4 +123,4 @@ TEST(MarcherAgreement, GlassSphereWithSmokeUnderASphereLight) {
 }
 
 }  // namespace
-}  // namespace vdbmarch::testing
+}  // namespace vdbmarch

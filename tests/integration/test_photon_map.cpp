@@ -14,12 +14,12 @@
 #include "marchers/marcher.h"
 #include "photons/photon_map.h"
 #include "photons/photon_tracer.h"
-#include "test_helpers.h"
+#include "support/support.h"
 
 namespace vdbmarch {
 namespace {
 
-using testing::sceneFromJson;
+using test::sceneFromJson;
 
 constexpr float SigmaA = 0.25f, SigmaS = 1.f, Intensity = 10.f;
 const Vec3 LightPos(0, 3, 0);

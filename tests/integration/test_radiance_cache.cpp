@@ -6,22 +6,21 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
+
+#include <openvdb/openvdb.h>
 
 #include "cache/cache_build.h"
-#include "illumination/bake.h"
 #include "cache/sh.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "core/sampling.h"
-#include "test_helpers.h"
+#include "illumination/bake.h"
+#include "support/support.h"
 
 namespace vdbmarch {
 namespace {
 
-using testing::sceneFromJson;
-using testing::tempDir;
+using namespace test;
 
 std::string spotScene(float g, bool adaptive) {
     return str(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
@@ -97,12 +96,7 @@ TEST(RadianceCache, NonScatteringSceneHasNothingToBake) {
         "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [1, 1, 1]}],
         "media": [{"name": "m", "type": "homogeneous", "sigma_a": [1, 1, 1], "sigma_s": [0, 0, 0],
                    "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}]})");
-    try {
-        bake(*scene);
-        FAIL() << "expected InputError";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("no medium scatters"), std::string::npos) << e.what();
-    }
+    EXPECT_CONTAINS(errorOf<InputError>([&] { bake(*scene); }), "no medium scatters");
 }
 
 TEST(RadianceCache, AdaptiveCellsTileSpaceAndRefineWherePhotonsAreDense) {
@@ -256,7 +250,8 @@ TEST(RadianceCacheFile, RoundTripKeepsEveryCellAndCoefficient) {
     for (bool adaptive : {false, true}) {
         auto scene = sceneFromJson(spotScene(0.7f, adaptive));
         BakeResult r = bake(*scene);
-        std::string path = tempDir() + str("/roundtrip", adaptive, ".vdb");
+        TempDir dir("cache");
+        std::string path = dir / str("roundtrip", adaptive, ".vdb");
         r.cache.save(path);
         RadianceCache back = RadianceCache::load(path);
         ASSERT_EQ(back.cells.size(), r.cache.cells.size());
@@ -278,13 +273,8 @@ TEST(RadianceCacheFile, RefusesAnotherScene) {
     auto scene = sceneFromJson(spotScene(0.7f, false));
     BakeResult r = bake(*scene);
     auto other = sceneFromJson(spotScene(0.5f, false));
-    try {
-        checkCacheMatchesScene(r.cache, *other, "c.vdb", false);
-        FAIL() << "expected InputError";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("another scene"), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
-    }
+    expectErrorContaining<InputError>([&] { checkCacheMatchesScene(r.cache, *other, "c.vdb", false); },
+                                      {"another scene", "--force"});
     setWarningsQuiet(true);
     EXPECT_NO_THROW(checkCacheMatchesScene(r.cache, *other, "c.vdb", true));
     setWarningsQuiet(false);
@@ -295,23 +285,17 @@ TEST(RadianceCacheFile, RefusesAnotherScene) {
 }
 
 void expectInputError(const std::string& path, const std::string& fragment) {
-    try {
-        RadianceCache::load(path);
-        FAIL() << "expected an error loading " << path;
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
+    expectErrorContaining<InputError>([&] { RadianceCache::load(path); }, {path, fragment});
 }
 
 TEST(RadianceCacheFile, TruncatedOrCorruptedFilesFailCleanly) {
     setWarningsQuiet(true);  // truncated files lose their checksum trailer
     auto scene = sceneFromJson(spotScene(0.7f, true));
     BakeResult r = bake(*scene);
-    std::string good = tempDir() + "/good.vdb";
+    TempDir dir("cache");
+    std::string good = dir / "good.vdb";
     r.cache.save(good);
-    std::ifstream in(good, std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string bytes = readBytes(good);
     ASSERT_GT(bytes.size(), 1000u);
     // Truncations at many lengths, and bytes overwritten with garbage: each
     // is an InputError naming the file (the checksum trailer catches the
@@ -325,27 +309,21 @@ TEST(RadianceCacheFile, TruncatedOrCorruptedFilesFailCleanly) {
             size_t at = size_t(rng.uniform() * float(bytes.size() - 64));
             for (size_t i = 0; i < 32; ++i) damaged[at + i] = char(rng.next() & 0xff);
         }
-        std::string path = tempDir() + str("/damaged", trial, ".vdb");
-        std::ofstream(path, std::ios::binary) << damaged;
-        try {
-            RadianceCache::load(path);
-            ADD_FAILURE() << "trial " << trial << ": a damaged cache loaded";
-        } catch (const InputError& e) {
-            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-        }
+        std::string path = dir.write(str("damaged", trial, ".vdb"), damaged);
+        SCOPED_TRACE(str("trial ", trial));
+        EXPECT_CONTAINS(errorOf<InputError>([&] { RadianceCache::load(path); }), path);
     }
-    std::string missing = tempDir() + "/does_not_exist.vdb";
+    std::string missing = dir / "does_not_exist.vdb";
     EXPECT_THROW(RadianceCache::load(missing), IoError);
     // A VDB that is not a cache (a density grid), and a cache of another format version.
-    std::string density = tempDir() + "/density.vdb";
-    testing::writeBoxGrid(density, openvdb::Coord(0), openvdb::Coord(3), 1.f, 0.1);
+    std::string density = writeBoxGrid(dir / "density.vdb", 0, 3, 1.f, 0.1);
     expectInputError(density, "not a vdbmarch cache");
     openvdb::io::File file(good);
     file.open();
     openvdb::GridPtrVecPtr grids = file.getGrids();
     file.close();
     for (auto& g : *grids) g->insertMeta("vdbmarch_cache_version", openvdb::Int32Metadata(99));
-    std::string future = tempDir() + "/future.vdb";
+    std::string future = dir / "future.vdb";
     openvdb::io::File(future).write(*grids);
     expectInputError(future, "version 99");
     setWarningsQuiet(false);

@@ -4,10 +4,12 @@
 
 #include <cmath>
 
-#include "test_helpers.h"
+#include "support/support.h"
 
-namespace vdbmarch::testing {
+namespace vdbmarch {
 namespace {
+
+using namespace test;
 
 // Orthographic rays along -z through a world fog box [-2,2]^3 (sigma_w) that
 // holds a unit sphere (interface) filled with sigma_i: the transmittance of a
@@ -59,37 +61,32 @@ TEST(Glass, LosslessDielectricsConserveRadianceUnderUniformBackground) {
         }
 }
 
-}  // namespace
-}  // namespace vdbmarch::testing
-
-namespace vdbmarch::testing {
-namespace {
-
 // Index-matched glass (ior 1) bends nothing, so shadow rays cross it: an
 // ior-1 sphere around a medium gives the same image as an interface sphere in
-// expectation, for both methods (glass draws one more random number per
+// expectation, for every method (glass draws one more random number per
 // crossing, so the noise differs): the mean per-pixel difference is zero
 // within 4 standard errors. Blocked shadow rays would darken it by far more.
 TEST(Glass, IndexMatchedGlassLetsShadowRaysThrough) {
-    auto scene = [](const std::string& material, const std::string& method) {
+    auto scene = [](const std::string& material, Method method) {
         return sceneFromJson(R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_deg": 30, "resolution": [16, 16]},
             "lights": [{"type": "point", "position": [2, 3, 2], "intensity": 20}],
             "media": [{"name": "m", "type": "homogeneous", "sigma_s": 2, "sigma_a": 0.1}],
             "surfaces": [{"shape": "sphere", "material": )" + material + R"(, "interior": "m"}],
-            "render": {"method": ")" + method + R"(", "spp": 4, "step": 0.01, "seed": 5}})");
+            "render": {"method": ")" + std::string(methodName(method)) + R"(", "spp": 4, "step": 0.01, "seed": 5}})");
     };
-    for (const std::string method : {"uniform", "reference"}) {
+    for (Method method : marcherMethods()) {
+        SCOPED_TRACE(methodName(method));
         RenderResult a = renderImage(*scene(R"({"type": "interface"})", method));
         RenderResult b = renderImage(*scene(R"({"type": "dielectric", "ior": 1})", method));
         Image diff(a.image.width, a.image.height);
         for (int y = 0; y < diff.height; ++y)
             for (int x = 0; x < diff.width; ++x) diff.set(x, y, a.image.rgb(x, y) - b.image.rgb(x, y), 0);
         ChannelStats sa = pixelStats(a.image, 0), d = pixelStats(diff, 0);
-        EXPECT_GT(sa.mean, 0.01) << method;
-        EXPECT_NEAR(d.mean, 0.0, 4 * d.stdError + 1e-7) << method;
-        EXPECT_LT(4 * d.stdError, 0.2 * sa.mean) << method;  // power: blocking would remove most of the light
+        EXPECT_GT(sa.mean, 0.01);
+        EXPECT_NEAR(d.mean, 0.0, 4 * d.stdError + 1e-7);
+        EXPECT_LT(4 * d.stdError, 0.2 * sa.mean);  // power: blocking would remove most of the light
     }
 }
 
 }  // namespace
-}  // namespace vdbmarch::testing
+}  // namespace vdbmarch

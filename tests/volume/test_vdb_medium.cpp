@@ -11,16 +11,15 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "core/transform.h"
+#include "support/support.h"
 #include "volume/medium.h"
 
 namespace vdbmarch {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string assetPath(const std::string& name) {
-    return std::string(VDBMARCH_SOURCE_DIR) + "/../shared/assets/" + name;
-}
+using test::assetPath;
+using test::samplePath;
 
 struct VoxelProbe {
     openvdb::Vec3d world;
@@ -29,7 +28,7 @@ struct VoxelProbe {
 
 // Every `stride`-th active voxel or tile centre, with its world position.
 std::vector<VoxelProbe> probes(const std::string& file, size_t stride, bool tilesOnly = false) {
-    openvdb::initialize();
+    initOpenVdb();
     openvdb::io::File f(file);
     f.open();
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid("density"));
@@ -81,12 +80,12 @@ void checkDensityAtVoxelCentres(const std::string& file, const Mat4& sceneTransf
 }
 
 TEST(VdbMedium, SampleCloudDensityAtVoxelCentres) {
-    checkDensityAtVoxelCentres(std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.vdb", Mat4::identity(), 97, false);
+    checkDensityAtVoxelCentres(samplePath("cloud.vdb"), Mat4::identity(), 97, false);
 }
 
 TEST(VdbMedium, SceneTransformIsAppliedAfterTheGrids) {
     Mat4 m = Mat4::translate(Vec3(3, -1, 2)) * Mat4::rotate(Vec3(1, 2, 0.5f), 37) * Mat4::scale(Vec3(2, 0.5f, 1.5f));
-    checkDensityAtVoxelCentres(std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/cloud.vdb", m, 131, false);
+    checkDensityAtVoxelCentres(samplePath("cloud.vdb"), m, 131, false);
 }
 
 TEST(VdbMedium, AffineDragonHonoursItsRotatedNonUniformTransform) {

@@ -8,14 +8,15 @@
 #include <functional>
 #include <vector>
 
-#include "chi_square.h"
 #include "core/rng.h"
 #include "marchers/ray_pdf.h"
+#include "support/support.h"
 
 namespace vdbmarch {
 namespace {
 
-using testing::chiSquareQ;
+using test::pooledChiSquare;
+using test::SampleStats;
 
 // A synthetic ray: 60 steps of 0.05 with varying extinction, some of them
 // not scattering (sigma_s = 0), through a medium of optical depth ~ 3.
@@ -102,20 +103,8 @@ TEST(RayPdf, IntegratesToOneAndMatchesItsSamples) {
                                pdf.pdf(int(b / sub), float(a + i * (c - a) / n)) * (c - a) / n / 3 * samples;
         }
         // Pool bins with small expectations, as the chi-square test needs.
-        double chi2 = 0, accO = 0, accE = 0;
-        int dof = -1;
-        for (size_t b = 0; b < expected.size(); ++b) {
-            accO += observed[b];
-            accE += expected[b];
-            if (accE >= 20 || b + 1 == expected.size()) {
-                if (accE > 0) {
-                    chi2 += (accO - accE) * (accO - accE) / accE;
-                    ++dof;
-                }
-                accO = accE = 0;
-            }
-        }
-        EXPECT_GT(chiSquareQ(chi2, dof), 1e-4) << "chi2 " << chi2 << " dof " << dof << (guided ? " guided" : "");
+        test::ChiSquare c = pooledChiSquare(observed, expected, 20);
+        EXPECT_GT(c.p(), 1e-4) << "chi2 " << c.chi2 << " dof " << c.dof << (guided ? " guided" : "");
     }
 }
 
@@ -129,7 +118,7 @@ EstimatorStats estimate(const SyntheticRay& r, const float* h, int n, int repeat
     RayPdf pdf;
     pdf.build(r.steps, h);
     Rng rng(seed);
-    double sum = 0, sum2 = 0;
+    SampleStats estimates;
     for (int rep = 0; rep < repeats; ++rep) {
         double e = 0;
         for (int j = 0; j < n; ++j) {
@@ -139,14 +128,9 @@ EstimatorStats estimate(const SyntheticRay& r, const float* h, int n, int repeat
             pdf.sample((j + rng.uniform()) / n, k, x, p);
             e += r.weight(k, x) * syntheticLi(r.steps[size_t(k)].t0 + x) / (n * p);
         }
-        sum += e;
-        sum2 += e * e;
+        estimates.add(e);
     }
-    EstimatorStats s;
-    s.mean = sum / repeats;
-    s.variance = (sum2 / repeats - s.mean * s.mean) * repeats / (repeats - 1);
-    s.stdError = std::sqrt(s.variance / repeats);
-    return s;
+    return {estimates.mean(), estimates.stdError(), estimates.variance()};
 }
 
 TEST(RayPdf, GuidedEstimatorIsUnbiasedForAnyHistogram) {

@@ -11,11 +11,12 @@
 #include "core/sampling.h"
 #include "photons/photon_emission.h"
 #include "scene/lights.h"
+#include "support/support.h"
 
 namespace vdbmarch {
 namespace {
 
-constexpr double PiD = 3.14159265358979323846;
+using namespace test;
 
 BBox makeBox(const Vec3& lo, const Vec3& hi) {
     BBox b;
@@ -28,53 +29,6 @@ PhotonTarget boundedTarget(const Vec3& lo, const Vec3& hi) { return {makeBox(lo,
 
 // Radius of the bounding sphere the emitters use (1% margin).
 double targetRadius(const PhotonTarget& t) { return 0.5 * length(t.bounds.extent()) * 1.01; }
-
-LightDesc pointLight(const Vec3& p, const Color& intensity) {
-    LightDesc d;
-    d.type = LightDesc::Type::Point;
-    d.position = p;
-    d.intensity = intensity;
-    return d;
-}
-
-LightDesc spotLight(const Vec3& p, const Vec3& dir, float coneDeg, float falloffDeg, const Color& intensity) {
-    LightDesc d;
-    d.type = LightDesc::Type::Spot;
-    d.position = p;
-    d.direction = normalize(dir);
-    d.coneDeg = coneDeg;
-    d.falloffDeg = falloffDeg;
-    d.intensity = intensity;
-    return d;
-}
-
-LightDesc directionalLight(const Vec3& dir, const Color& irradiance) {
-    LightDesc d;
-    d.type = LightDesc::Type::Directional;
-    d.direction = normalize(dir);
-    d.irradiance = irradiance;
-    return d;
-}
-
-LightDesc quadLight(const Vec3& c, const Vec3& u, const Vec3& v, const Vec3& dir, const Color& irradiance) {
-    LightDesc d;
-    d.type = LightDesc::Type::CollimatedQuad;
-    d.center = c;
-    d.u = u;
-    d.v = v;
-    d.direction = normalize(dir);
-    d.irradiance = irradiance;
-    return d;
-}
-
-LightDesc sphereLight(const Vec3& p, float radius, const Color& power) {
-    LightDesc d;
-    d.type = LightDesc::Type::Sphere;
-    d.position = p;
-    d.radius = radius;
-    d.power = power;
-    return d;
-}
 
 // Sum and sum of squares of per-photon contributions (photons that
 // contribute nothing count as zeros).
@@ -161,6 +115,13 @@ void expectPowerIsMean(const PhotonEmitter& e, const Shot& s) {
     }
 }
 
+// Shoots n photons: the discs get their irradiance, and power() is the mean.
+void expectIrradianceAndPower(const PhotonEmitter& e, const std::vector<TestDisc>& discs, long n, uint64_t seed) {
+    Shot s = shoot(e, discs, n, seed);
+    expectIrradiance(s, discs);
+    expectPowerIsMean(e, s);
+}
+
 // Irradiance a delta light gives a disc at x with normal n, from Light::sample.
 double deltaIrradiance(const Light& l, const Vec3& x, const Vec3& n) {
     LightSample ls;
@@ -194,9 +155,7 @@ TEST(PhotonEmissionPoint, InsideTargetShootsWholeSphere) {
                              {{-0.5f, -0.6f, 0.7f}, {1, 1, 0}},
                              {{0.2f, 0.9f, 0.5f}, {0, 0, 1}}},
                             0.04);
-    Shot s = shoot(e, discs, 4000000, 1);
-    expectIrradiance(s, discs);
-    expectPowerIsMean(e, s);
+    expectIrradianceAndPower(e, discs, 4000000, 1);
 }
 
 TEST(PhotonEmissionPoint, OutsideTargetShootsConeAtItsBoundingSphere) {
@@ -213,9 +172,7 @@ TEST(PhotonEmissionPoint, OutsideTargetShootsConeAtItsBoundingSphere) {
                              {{-0.8f, 0.2f, 0.6f}, {1, -1, 2}},
                              {{0, 0, 0}, {0, 1, 0}}},
                             0.06);
-    Shot s = shoot(e, discs, 3000000, 2);
-    expectIrradiance(s, discs);
-    expectPowerIsMean(e, s);
+    expectIrradianceAndPower(e, discs, 3000000, 2);
 }
 
 // A tiny target cone (distant light) keeps its spread despite float cosines.
@@ -251,9 +208,7 @@ TEST(PhotonEmissionSpot, NarrowSpotInsideTargetCone) {
     ASSERT_GT(discs[1].expected, 0);
     ASSERT_LT(discs[1].expected, deltaIrradiance(light, {0, 0, 0}, {0, 1, 0}));  // really in the falloff
     ASSERT_EQ(discs[3].expected, 0);
-    Shot s = shoot(e, discs, 3000000, 4);
-    expectIrradiance(s, discs);
-    expectPowerIsMean(e, s);
+    expectIrradianceAndPower(e, discs, 3000000, 4);
 }
 
 // Wide spot far away: the target cone is narrower and is the one sampled;
@@ -268,9 +223,7 @@ TEST(PhotonEmissionSpot, WideSpotSamplesTargetCone) {
                              {{-0.8f, -0.5f, 0.3f}, {1, 1, 1}}},
                             0.1);
     for (const TestDisc& d : discs) ASSERT_GT(d.expected, 0);
-    Shot s = shoot(e, discs, 2000000, 5);
-    expectIrradiance(s, discs);
-    expectPowerIsMean(e, s);
+    expectIrradianceAndPower(e, discs, 2000000, 5);
 }
 
 // Cones overlapping in part, either one sampled, smooth and hard edges: the
@@ -291,7 +244,7 @@ TEST(PhotonEmissionSpot, PartialOverlapPowerIsMean) {
     };
     int seed = 10;
     for (const Case& c : cases) {
-        SCOPED_TRACE(testing::Message() << "cone " << c.cone << " falloff " << c.falloff);
+        SCOPED_TRACE(::testing::Message() << "cone " << c.cone << " falloff " << c.falloff);
         Light light(spotLight(c.position, c.direction, c.cone, c.falloff, {1, 2, 3}));
         PhotonEmitter e = PhotonEmitter::forLight(light, target);
         ASSERT_GT(e.power().x, 0);
@@ -338,9 +291,7 @@ TEST(PhotonEmissionDirectional, DiscCoversTarget) {
                              {{1.7f, 0.7f, 0.2f}, {0, 1, 0}},
                              {{-0.7f, -0.7f, 0.8f}, {1, 0, 1}}},
                             0.25);
-    Shot s = shoot(e, discs, 1000000, 30);
-    expectIrradiance(s, discs);
-    expectPowerIsMean(e, s);
+    expectIrradianceAndPower(e, discs, 1000000, 30);
     // Every photon starts outside the bounding sphere.
     Rng rng(31);
     for (int i = 0; i < 1000; ++i) {
@@ -383,9 +334,7 @@ TEST(PhotonEmissionCollimatedQuad, IrradianceInsideAndOutsideBeam) {
         }
     }
     ASSERT_EQ(discs[3].expected, 0);
-    Shot s = shoot(e, discs, 1000000, 40);
-    expectIrradiance(s, discs);
-    expectPowerIsMean(e, s);
+    expectIrradianceAndPower(e, discs, 1000000, 40);
 }
 
 TEST(PhotonEmissionCollimatedQuad, BeamMissingTargetHasNoPower) {
@@ -484,9 +433,7 @@ TEST(PhotonEmissionEnvironment, ConstantRadianceGivesPiL) {
     for (auto [x, n] : std::vector<std::pair<Vec3, Vec3>>{
              {{0, 0, 1}, {0, 0, 1}}, {{0.7f, -0.3f, 0.2f}, {1, -1, 0}}, {{-0.6f, 0.3f, 1.7f}, {-1, 2, -3}}})
         discs.push_back({x, normalize(n), 0.25, PiD * radiance.x, true});
-    Shot s = shoot(e, discs, 1000000, 70);
-    expectIrradiance(s, discs);
-    expectPowerIsMean(e, s);
+    expectIrradianceAndPower(e, discs, 1000000, 70);
 }
 
 // An unbounded target still uses its (finite) box for the disc emitters and

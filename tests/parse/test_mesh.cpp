@@ -1,57 +1,33 @@
 #include "parse/mesh.h"
 
 #include "core/error.h"
+#include "support/support.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <type_traits>
-#include <unistd.h>
 
 namespace vdbmarch {
 namespace {
 
 namespace fs = std::filesystem;
+using test::expectErrorContaining;
 
 // Each test gets its own scratch directory, removed afterwards.
 class MeshFiles : public ::testing::Test {
 protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        mDir = fs::temp_directory_path() /
-               ("vdbmarch_mesh_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(mDir);
-        fs::create_directories(mDir);
-    }
-    void TearDown() override {
-        std::error_code ec;
-        fs::remove_all(mDir, ec);
-    }
-    std::string write(const std::string& name, const std::string& bytes) {
-        std::string path = (mDir / name).string();
-        std::ofstream out(path, std::ios::binary);
-        out.write(bytes.data(), std::streamsize(bytes.size()));
-        return path;
-    }
-    fs::path mDir;
+    std::string write(const std::string& name, const std::string& bytes) { return mDir.write(name, bytes); }
+    test::TempDir mDir{"mesh"};
 };
 
-// Expects `fn` to throw E whose message contains every needle.
-template <typename E, typename Fn>
-void expectThrowWith(Fn&& fn, std::initializer_list<std::string> needles) {
-    try {
-        fn();
-        ADD_FAILURE() << "no exception thrown";
-    } catch (const E& e) {
-        std::string what = e.what();
-        for (const std::string& n : needles) EXPECT_NE(what.find(n), std::string::npos) << "'" << n << "' not in: " << what;
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "wrong exception type: " << e.what();
-    }
+// loadMesh(path) throws exactly an E whose message contains every needle.
+template <typename E>
+void expectLoadError(const std::string& path, std::initializer_list<std::string> needles) {
+    expectErrorContaining<E>([&] { loadMesh(path); }, needles);
 }
 
 // Writes PLY body values either as ASCII text or raw bytes in a given
@@ -91,6 +67,14 @@ private:
 
 const char* formatName(Enc enc) {
     return enc == Enc::Ascii ? "ascii" : enc == Enc::Little ? "binary_little_endian" : "binary_big_endian";
+}
+
+// An ASCII PLY of `vertices` float x, y, z and `faces` faces (uchar count,
+// int indices), then `body`.
+std::string asciiPly(int vertices, int faces, const std::string& body) {
+    return str("ply\nformat ascii 1.0\nelement vertex ", vertices,
+               "\nproperty float x\nproperty float y\nproperty float z\nelement face ", faces,
+               "\nproperty list uchar int vertex_indices\nend_header\n", body);
 }
 
 // Five vertices, a triangle and a quad; x,y,z of three different types, and
@@ -145,6 +129,13 @@ std::string richPly(Enc enc) {
     return header + b.str();
 }
 
+// `m` has `count` vertices, vertex `i` at `p`, and these triangle indices.
+void expectMesh(const TriangleMesh& m, size_t count, size_t i, const Vec3& p, const std::vector<uint32_t>& indices) {
+    ASSERT_EQ(m.positions.size(), count);
+    EXPECT_EQ(m.positions[i], p);
+    EXPECT_EQ(m.indices, indices);
+}
+
 void expectRichMesh(const TriangleMesh& m) {
     const std::vector<Vec3> positions = {
         {0.5f, -1.25f, 0}, {1, 0, 3}, {-2.75f, 4.5f, -7}, {3, 1.5f, 2}, {0.125f, 2, 5}};
@@ -175,10 +166,7 @@ TEST_F(MeshFiles, PlyUppercaseExtensionAndCrlfHeader) {
         "property float z\r\nproperty float confidence\r\nproperty float intensity\r\n"
         "element face 2\r\nproperty list uchar int vertex_indices\r\nend_header\r\n"
         "0 0 0 1 0.5\r\n1 0 0 1 0.5\r\n1 1 0 1 0.5\r\n0 1 0 1 0.5\r\n3 0 1 2\r\n3 0 2 3\r\n";
-    TriangleMesh m = loadMesh(write("quad.PLY", text));
-    ASSERT_EQ(m.positions.size(), 4u);
-    EXPECT_EQ(m.positions[2], Vec3(1, 1, 0));
-    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+    expectMesh(loadMesh(write("quad.PLY", text)), 4, 2, Vec3(1, 1, 0), {0, 1, 2, 0, 2, 3});
 }
 
 TEST_F(MeshFiles, PlyVertexElementAfterFaces) {
@@ -186,19 +174,13 @@ TEST_F(MeshFiles, PlyVertexElementAfterFaces) {
         "ply\nformat ascii 1.0\nelement face 1\nproperty list uint uint vertex_indices\n"
         "element vertex 3\nproperty uchar x\nproperty char y\nproperty ushort z\nend_header\n"
         "3 2 1 0\n1 2 3\n4 -5 6\n7 8 9\n";
-    TriangleMesh m = loadMesh(write("late.ply", text));
-    ASSERT_EQ(m.positions.size(), 3u);
-    EXPECT_EQ(m.positions[1], Vec3(4, -5, 6));
-    EXPECT_EQ(m.indices, (std::vector<uint32_t>{2, 1, 0}));
+    expectMesh(loadMesh(write("late.ply", text)), 3, 1, Vec3(4, -5, 6), {2, 1, 0});
 }
 
 TEST_F(MeshFiles, DegenerateTrianglesAreDropped) {
     setWarningsQuiet(true);
     int before = warningCount();
-    std::string text =
-        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face 3\nproperty list uchar int vertex_indices\nend_header\n"
-        "0 0 0\n1 0 0\n0 1 0\n3 0 0 1\n3 0 1 2\n2 0 1\n";
+    std::string text = asciiPly(3, 3, "0 0 0\n1 0 0\n0 1 0\n3 0 0 1\n3 0 1 2\n2 0 1\n");
     TriangleMesh m = loadMesh(write("degenerate.ply", text));
     EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
     EXPECT_EQ(warningCount(), before + 1);  // one summary warning, not one per face
@@ -213,47 +195,36 @@ TEST_F(MeshFiles, ObjShapesMergedAndPolygonsTriangulated) {
         "o first\nf 1/1/1 2/1/1 3/1/1 4/1/1\n"
         "o second\nf -5 -4 -1\n"
         "g third\nf 2//1 3//1 5//1\n";
-    TriangleMesh m = loadMesh(write("shapes.OBJ", text));
-    ASSERT_EQ(m.positions.size(), 5u);
-    EXPECT_EQ(m.positions[4], Vec3(0, 0, 2.5f));
-    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 1, 4, 1, 2, 4}));
+    expectMesh(loadMesh(write("shapes.OBJ", text)), 5, 4, Vec3(0, 0, 2.5f), {0, 1, 2, 0, 2, 3, 0, 1, 4, 1, 2, 4});
 }
 
 TEST_F(MeshFiles, ObjIndexOutOfRange) {
     std::string path = write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {path, "9", "3 vertices"});
+    expectLoadError<InputError>(path, {path, "9", "3 vertices"});
 }
 
 TEST_F(MeshFiles, PlyIndexOutOfRange) {
-    std::string text =
-        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
-        "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 7 1\n";
-    std::string path = write("range.ply", text);
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {path, "index 7", "4 vertices"});
+    std::string path = write("range.ply", asciiPly(4, 1, "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 7 1\n"));
+    expectLoadError<InputError>(path, {path, "index 7", "4 vertices"});
 }
 
 TEST_F(MeshFiles, NegativePlyIndexIsOutOfRange) {
-    std::string text =
-        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
-        "0 0 0\n1 0 0\n0 1 0\n3 0 -1 1\n";
-    std::string path = write("negative.ply", text);
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {"-1", "3 vertices"});
+    std::string path = write("negative.ply", asciiPly(3, 1, "0 0 0\n1 0 0\n0 1 0\n3 0 -1 1\n"));
+    expectLoadError<InputError>(path, {"-1", "3 vertices"});
 }
 
 TEST_F(MeshFiles, MissingFile) {
-    std::string path = (mDir / "nope.ply").string();
-    expectThrowWith<IoError>([&] { loadMesh(path); }, {path});
-    std::string objPath = (mDir / "nope.obj").string();
-    expectThrowWith<IoError>([&] { loadMesh(objPath); }, {objPath});
+    std::string path = mDir / "nope.ply";
+    expectLoadError<IoError>(path, {path});
+    std::string objPath = mDir / "nope.obj";
+    expectLoadError<IoError>(objPath, {objPath});
 }
 
 TEST_F(MeshFiles, UnknownExtension) {
     std::string path = write("mesh.stl", "solid x\n");
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {path, ".stl"});
+    expectLoadError<InputError>(path, {path, ".stl"});
     std::string noExt = write("mesh", "ply\n");
-    expectThrowWith<InputError>([&] { loadMesh(noExt); }, {noExt});
+    expectLoadError<InputError>(noExt, {noExt});
 }
 
 TEST_F(MeshFiles, BadHeaders) {
@@ -285,7 +256,7 @@ TEST_F(MeshFiles, BadHeaders) {
     for (const Case& c : cases) {
         std::string path = write("header.ply", c.text);
         SCOPED_TRACE(c.text);
-        expectThrowWith<InputError>([&] { loadMesh(path); }, {path, c.needle});
+        expectLoadError<InputError>(path, {path, c.needle});
     }
 }
 
@@ -295,11 +266,11 @@ TEST_F(MeshFiles, TruncatedBinary) {
     for (size_t cut : {size_t(40), size_t(150)}) {
         std::string path = write("cut.ply", full.substr(0, full.size() - cut));
         SCOPED_TRACE(cut);
-        expectThrowWith<InputError>([&] { loadMesh(path); }, {path, "truncated"});
+        expectLoadError<InputError>(path, {path, "truncated"});
     }
     const std::string bigEndian = richPly(Enc::Big);
     std::string path = write("cut_be.ply", bigEndian.substr(0, bigEndian.size() - 1));
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {"truncated", "material"});
+    expectLoadError<InputError>(path, {"truncated", "material"});
 }
 
 TEST_F(MeshFiles, TruncatedInSkippedTrailingElement) {
@@ -313,49 +284,41 @@ TEST_F(MeshFiles, TruncatedInSkippedTrailingElement) {
     const std::string full = header + b.str();
     EXPECT_EQ(loadMesh(write("whole.ply", full)).triangleCount(), 1u);
     std::string path = write("cut.ply", full.substr(0, full.size() - 3));
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {path, "truncated", "extra"});
+    expectLoadError<InputError>(path, {path, "truncated", "extra"});
 }
 
 TEST_F(MeshFiles, DirectoryIsAnIoError) {
-    fs::create_directories(mDir / "folder.ply");
-    std::string path = (mDir / "folder.ply").string();
-    expectThrowWith<IoError>([&] { loadMesh(path); }, {path});
+    std::string path = mDir / "folder.ply";
+    fs::create_directories(path);
+    expectLoadError<IoError>(path, {path});
 }
 
 TEST_F(MeshFiles, TruncatedAscii) {
-    std::string text =
-        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n";
-    std::string path = write("cut.ply", text);
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {path, "truncated", "face"});
+    std::string path = write("cut.ply", asciiPly(3, 1, "0 0 0\n1 0 0\n0 1 0\n3 0 1\n"));
+    expectLoadError<InputError>(path, {path, "truncated", "face"});
 }
 
 TEST_F(MeshFiles, NonFiniteCoordinates) {
-    std::string text =
-        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n";
+    std::string text = asciiPly(3, 1, "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
     std::string path = write("nan.ply", text);
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {path, "vertex 1", "non-finite"});
+    expectLoadError<InputError>(path, {path, "vertex 1", "non-finite"});
 
     // A double beyond float range cannot be stored either.
     std::string big = text;
     big.replace(big.find("1 nan 0"), 7, "1 1e300 0");
     std::string bigPath = write("big.ply", big);
-    expectThrowWith<InputError>([&] { loadMesh(bigPath); }, {"vertex 1"});
+    expectLoadError<InputError>(bigPath, {"vertex 1"});
 
     std::string objPath = write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1 1e999\nf 1 2 3\n");
-    expectThrowWith<InputError>([&] { loadMesh(objPath); }, {objPath, "vertex 2", "non-finite"});
+    expectLoadError<InputError>(objPath, {objPath, "vertex 2", "non-finite"});
 }
 
 TEST_F(MeshFiles, ZeroTriangles) {
     setWarningsQuiet(true);
-    std::string text =
-        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n";
-    std::string path = write("flat.ply", text);
-    expectThrowWith<InputError>([&] { loadMesh(path); }, {path, "no"});
+    std::string path = write("flat.ply", asciiPly(3, 1, "0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n"));
+    expectLoadError<InputError>(path, {path, "no"});
     std::string objPath = write("points.obj", "v 0 0 0\nv 1 0 0\n");
-    expectThrowWith<InputError>([&] { loadMesh(objPath); }, {objPath, "no"});
+    expectLoadError<InputError>(objPath, {objPath, "no"});
     setWarningsQuiet(false);
 }
 
@@ -449,7 +412,7 @@ TEST(MeshTopology, TransformKeepsFrontOutward) {
 }
 
 TEST(MeshAssets, StanfordBunnyRes2) {
-    const std::string path = std::string(VDBMARCH_SOURCE_DIR) + "/../shared/assets/bun_zipper_res2.ply";
+    const std::string path = test::assetPath("bun_zipper_res2.ply");
     if (!fs::exists(path)) GTEST_SKIP() << "asset not present: " << path;
     TriangleMesh bunny = loadMesh(path);
     EXPECT_EQ(bunny.positions.size(), 8171u);

@@ -18,11 +18,12 @@
 #include "cache/sh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "support/support.h"
 
 namespace vdbmarch {
 namespace {
 
-constexpr double PiD = 3.14159265358979323846;
+using test::PiD;
 
 // Float evaluation of an order <= 8 basis: a recurrence of <= 9 steps with a
 // few roundings each, then a dot product; 64 ulps covers it with margin.

@@ -1,0 +1,150 @@
+#include "app/render_command.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "image/exr_io.h"
+#include "image/png_io.h"
+#include "parse/method.h"
+#include "parse/scene_json.h"
+#include "render/render.h"
+#include "scene/scene.h"
+
+namespace vdbmarch {
+
+const SceneOptionTable<RenderArgs>& renderSceneOptions() {
+    static const SceneOptionTable<RenderArgs> table = {
+        {"--method", "render.method", "Estimator: " + methodList(), &RenderArgs::method},
+        {"--spp", "render.spp", "Samples per pixel", &RenderArgs::spp},
+        {"--seed", "render.seed", "Random seed", &RenderArgs::seed},
+        {"--threads", "render.threads", "Worker threads (0 = all cores)", &RenderArgs::threads},
+        {"--step", "render.step", "March step in world units (default: one voxel)", &RenderArgs::step},
+        {"--exposure", "render.exposure", "PNG exposure in stops", &RenderArgs::exposure},
+        {"--li", "render.li",
+         "How marchers estimate L_i: photons (shadow rays + non-direct photons, default) or cache "
+         "(the radiance cache alone: fast, biased preview)",
+         &RenderArgs::li},
+        {"--ray-samples", "render.ray_samples",
+         "L_i samples per ray segment for transmittance and guided (render.ray_samples)", &RenderArgs::raySamples},
+        {"--sh-order", "cache.sh_order", "SH order of the cache built for guided; 0 = scalar cache (cache.sh_order)",
+         &RenderArgs::shOrder},
+    };
+    return table;
+}
+
+namespace {
+
+// Refuses bad option values and unwritable outputs before anything is loaded.
+void validate(const RenderArgs& a) {
+    if (!endsWith(a.output, ".exr"))
+        throw InputError(str("-o ", a.output, ": the output must be an .exr file"));
+    if (!a.png.empty() && !endsWith(a.png, ".png"))
+        throw InputError(str("--png ", a.png, ": the preview must be a .png file"));
+    if (!a.stats.empty() && !endsWith(a.stats, ".json"))
+        throw InputError(str("--stats ", a.stats, ": the statistics file must be a .json file"));
+    checkWritable(a.output);
+    if (!a.png.empty()) checkWritable(a.png);
+    if (!a.stats.empty()) checkWritable(a.stats);
+    if (!a.saveScene.empty()) checkWritable(a.saveScene);
+    if (a.spp && *a.spp < 1) throw InputError(str("--spp ", *a.spp, ": must be at least 1"));
+    if (a.seed && *a.seed < 0) throw InputError(str("--seed ", *a.seed, ": must be a non-negative integer"));
+    if (a.threads && *a.threads < 0)
+        throw InputError(str("--threads ", *a.threads, ": must be 0 (all cores) or more"));
+    if (a.step && !(*a.step > 0 && std::isfinite(*a.step)))
+        throw InputError(str("--step ", *a.step, ": must be a positive length in world units"));
+    if (a.timeBudget && !(*a.timeBudget > 0 && std::isfinite(*a.timeBudget)))
+        throw InputError(str("--time ", *a.timeBudget, ": must be a positive number of seconds"));
+    if (a.timeBudget && a.spp)
+        throw InputError("--time and --spp both given: a render is budgeted either by samples or by seconds");
+}
+
+// Timings, counts and counters of a finished render (--stats).
+std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& scene, const RenderResult& r,
+                      double loadSeconds, double total) {
+    const RenderCounters& c = r.counters;
+    nlohmann::json s;
+    s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"photons_and_cache", r.illuminationSeconds},
+                    {"total", total}};
+    s["photons"] = r.photons;
+    s["cache_cells"] = r.cacheCells;
+    s["threads"] = r.threads;
+    s["method"] = methodName(desc.render.method);
+    s["spp"] = r.spp;
+    if (a.timeBudget) s["time_budget"] = *a.timeBudget;
+    s["resolution"] = {r.image.width, r.image.height};
+    s["step"] = scene.step;
+    s["shadow_step"] = scene.shadowStep;
+    s["counters"] = {{"camera_rays", c.cameraRays},         {"surface_hits", c.surfaceHits},
+                     {"march_samples", c.marchSamples},     {"li_samples", c.liSamples},
+                     {"shadow_rays", c.shadowRays},
+                     {"shadow_samples", c.shadowSamples},   {"non_finite_samples", c.nonFiniteSamples},
+                     {"marched_length", c.marchedLength},   {"skipped_empty_length", c.skippedLength}};
+    return s.dump(2) + "\n";
+}
+
+}  // namespace
+
+int runRender(const RenderArgs& a) {
+    auto t0 = std::chrono::steady_clock::now();
+    validate(a);
+    // Command-line options are overrides of the scene document, so they are
+    // validated by the same parser and recorded in the output.
+    std::vector<std::string> overrides = a.sets;
+    appendSceneOverrides(a, renderSceneOptions(), overrides);
+    if (!a.res.empty()) overrides.push_back(resolutionOverride(a.res));
+    if (!a.cache.empty() && !endsWith(a.cache, ".vdb"))
+        throw InputError(str("--cache ", a.cache, ": the cache must be a .vdb file written by vdbmarch bake"));
+    if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
+
+    SceneDesc desc = loadSceneInput(a.input, overrides);
+    std::unique_ptr<Scene> scene = buildScene(desc);
+    double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    RenderOptions options;
+    options.illumination.cacheFile = a.cache;
+    options.illumination.force = a.force;
+    options.progress = !a.quiet && !a.noProgress && isatty(STDERR_FILENO);
+    if (a.timeBudget) {
+        options.timeBudget = *a.timeBudget;
+        options.runStart = t0;
+    }
+    RenderResult r = renderImage(*scene, options);
+    if (r.counters.nonFiniteSamples > 0)
+        warn(str(r.counters.nonFiniteSamples, " path sample(s) gave NaN or Inf and were dropped"));
+
+    StringAttributes attrs = {
+        {"vdbmarch:version", VDBMARCH_VERSION},
+        {"vdbmarch:source", desc.file},
+        {"vdbmarch:method", methodName(desc.render.method)},
+        {"vdbmarch:spp", std::to_string(r.spp)},
+        {"vdbmarch:timeBudget", a.timeBudget ? str(*a.timeBudget) : std::string("none")},
+        {"vdbmarch:seed", std::to_string(desc.render.seed)},
+        {"vdbmarch:step", str(scene->step)},
+        {"vdbmarch:shadowStep", str(scene->shadowStep)},
+        {"vdbmarch:renderSeconds", str(r.seconds)},
+        {"vdbmarch:scene", desc.jsonText},
+    };
+    writeExr(a.output, r.image, attrs);
+    if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
+    if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
+    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total));
+    if (!a.quiet)
+        std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
+                     r.image.width, r.image.height, r.spp, methodName(desc.render.method), double(scene->step),
+                     r.seconds,
+                     r.illuminationSeconds > 0
+                         ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s, ").c_str()
+                         : "",
+                     loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
+    return 0;
+}
+
+}  // namespace vdbmarch

@@ -1,0 +1,30 @@
+// `vdbmarch render`: a scene (or a bare .vdb) to EXR, with an optional PNG
+// preview, statistics JSON and the effective scene.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/command_line.h"
+
+namespace vdbmarch {
+
+struct RenderArgs {
+    std::string input, output, png, res, stats, saveScene, cache;
+    bool force = false, quiet = false, noProgress = false;
+    std::optional<double> timeBudget;  // --time
+    std::vector<std::string> sets;     // --set key.path=value
+    // Scene overrides (renderSceneOptions); unset ones keep the scene's values.
+    std::string method, li;
+    std::optional<int> spp, threads, raySamples, shOrder;
+    std::optional<long long> seed;
+    std::optional<double> step, exposure;
+};
+
+// The options of `render` that override scene keys (--spp -> render.spp, ...).
+const SceneOptionTable<RenderArgs>& renderSceneOptions();
+
+int runRender(const RenderArgs& args);
+
+}  // namespace vdbmarch

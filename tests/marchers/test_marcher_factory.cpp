@@ -1,0 +1,56 @@
+// The factory table: every Method has a marcher (so suites that run over
+// marcherMethods() cover every method a scene can ask for), and each one
+// makes a marcher that answers a camera ray.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "core/rng.h"
+#include "marchers/marcher.h"
+#include "parse/method.h"
+#include "support/support.h"
+#include "transport/thread_context.h"
+
+namespace vdbmarch {
+namespace {
+
+using namespace test;
+
+TEST(MarcherFactory, HasAnEntryForEveryMethod) {
+    const std::vector<Method> factory = marcherMethods();
+    const std::set<Method> fromFactory(factory.begin(), factory.end());
+    const std::set<Method> all(allMethods().begin(), allMethods().end());
+    EXPECT_EQ(fromFactory.size(), factory.size()) << "a method is listed twice in the factory table";
+    EXPECT_EQ(fromFactory, all) << "marcherMethods() and allMethods() differ";
+}
+
+class MarcherFactoryMethods : public ::testing::TestWithParam<Method> {};
+
+// An absorbing box in front of the camera: every marcher returns finite
+// radiance and a transmittance in [0, 1] per ray, and sees the box (mean
+// transmittance below 1; it is exp(-2) in expectation).
+TEST_P(MarcherFactoryMethods, MakesAMarcherThatAnswersARay) {
+    auto scene = sceneFromJson(R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "resolution": [4, 4]},
+        "media": [{"type": "homogeneous", "sigma_a": 1, "sigma_s": 0,
+                   "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}],
+        "background": [1, 1, 1], "render": {"step": 0.01}})");
+    auto marcher = makeMarcher(GetParam(), *scene);
+    ASSERT_NE(marcher, nullptr);
+    ThreadContext ctx(*scene);
+    Rng rng(1);
+    SampleStats transmittance;
+    for (int i = 0; i < 64; ++i) {
+        PathResult r = marcher->radiance(Ray{Vec3(0, 0, 3), Vec3(0, 0, -1)}, rng, ctx);
+        ASSERT_TRUE(isFinite(r.L));
+        ASSERT_GE(r.transmittance, 0.f);
+        ASSERT_LE(r.transmittance, 1.f);
+        transmittance.add(r.transmittance);
+    }
+    EXPECT_LT(transmittance.mean(), 1.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, MarcherFactoryMethods, ::testing::ValuesIn(marcherMethods()), methodParamName);
+
+}  // namespace
+}  // namespace vdbmarch
