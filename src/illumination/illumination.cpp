@@ -48,11 +48,12 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
         st.photons = set.photons.size();
         st.directPhotons = set.directCount;
         const auto treeStart = Clock::now();
-        if (rq.indirect && set.directCount < set.photons.size()) {
+        const size_t wanted = rq.causticsOnly ? set.causticCount : set.photons.size() - set.directCount;
+        if (rq.indirect && wanted > 0) {
             std::vector<Photon> indirect;
-            indirect.reserve(set.photons.size() - set.directCount);
+            indirect.reserve(wanted);
             for (const Photon& p : set.photons)
-                if (!p.isDirect()) indirect.push_back(p);
+                if (rq.causticsOnly ? p.isCaustic() : !p.isDirect()) indirect.push_back(p);
             il.indirect = std::make_unique<PhotonMap>(std::move(indirect));
             st.photonBytes += il.indirect->memoryBytes();
         }
@@ -97,13 +98,20 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     else if (!options.cacheFile.empty())
         warn(str(options.cacheFile, ": method ", methodName(method), " with render.li = \"", liSourceName(rs.li),
                  "\" does not read the cache; ignored"));
-    // Shadow rays compute the direct light; the photon map adds the rest,
-    // which exists when light may scatter before the last event, or pass
-    // refracting glass (a caustic, even for single scattering).
-    bool bendingGlass = false;
+    // Shadow rays compute the direct light. With photons, the photon map
+    // adds the rest, which exists when light may scatter before the last
+    // event, or pass refracting glass (a caustic, even for single
+    // scattering). With paths, photons add only the caustics of delta
+    // lights, which no path can find.
+    bool bendingGlass = false, deltaLight = false;
     for (const SurfaceInfo& s : scene.surfaces)
         bendingGlass = bendingGlass || (s.material.type == MaterialDesc::Type::Dielectric && s.material.ior != 1.f);
-    rq.indirect = rs.li == LiSource::Photons && (rs.maxDepth > 1 || bendingGlass);
+    for (const Light& l : scene.lights) deltaLight = deltaLight || l.isDelta();
+    if (rs.li == LiSource::Photons) rq.indirect = rs.maxDepth > 1 || bendingGlass;
+    if (rs.li == LiSource::Path) {
+        rq.indirect = bendingGlass && deltaLight;
+        rq.causticsOnly = true;
+    }
     return rq;
 }
 

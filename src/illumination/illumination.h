@@ -17,7 +17,8 @@ namespace vdbmarch {
 
 // What to build, and from which settings.
 struct IlluminationRequest {
-    bool indirect = false;     // the map of non-direct photons (eq. 4 beside shadow rays)
+    bool indirect = false;     // the map of photons for L_i beside shadow rays (and paths)
+    bool causticsOnly = false;  // ... only the caustic photons (render.li = "path")
     bool cache = false;        // the radiance cache
     bool keepAllPhotons = false;  // keep the map of every photon (bake, tests)
     PhotonSettings photons;
@@ -35,7 +36,10 @@ struct IlluminationStats {
 };
 
 struct Illumination {
-    std::unique_ptr<PhotonMap> indirect;   // non-direct photons; null when none can exist
+    // The photons L_i takes beside shadow rays: the non-direct ones
+    // (render.li = "photons"), or the caustic ones (render.li = "path"); null
+    // when none can exist.
+    std::unique_ptr<PhotonMap> indirect;
     std::unique_ptr<PhotonMap> all;        // every photon, only with keepAllPhotons
     std::unique_ptr<RadianceCache> cache;  // null unless requested
     int k = 50;                            // photons per estimate

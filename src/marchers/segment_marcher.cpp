@@ -4,13 +4,14 @@
 
 #include "core/error.h"
 #include "transport/direct_light.h"
+#include "transport/path_tracer.h"
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
 
 namespace vdbmarch {
 
 SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination)
-    : mScene(scene), mIllumination(std::move(illumination)) {
+    : mScene(scene), mIllumination(std::move(illumination)), mChromatic(hasChromaticExtinction(scene)) {
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
 }
 
@@ -30,6 +31,7 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
         float tLight = Infinity;
         int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
         float segEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+        scratch(ctx).pathDepth = diffuseBounces;
         if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f};
         if (light >= 0) {
             if (!lightsCounted) L += beta * scene.lights[size_t(light)].emittedRadiance();
@@ -45,8 +47,7 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
         const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            ScatterVertex v{h.p, ray.d, nullptr, h.n, albedo};
-            L += beta * directLight(ctx, region, v, rng, {});
+            L += beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, {});
             // Light that reaches the surface after scattering in a medium
             // (what shadow rays miss): continue the path in the cosine-
             // sampled direction, marching the media it crosses, as a
@@ -81,7 +82,32 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         c.setDirection(-rayDir);
         return Color(c.at(x));
     }
-    Color Li = directLight(ctx, region, ScatterVertex{x, rayDir, &mp.phase}, rng, {});
+    const ScatterVertex vertex = ScatterVertex::inMedium(x, rayDir, mp.phase);
+    if (il.li == LiSource::Photons) {
+        Color Li = directLight(ctx, region, vertex, rng, {});
+        if (il.indirect)
+            Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
+        return Li;
+    }
+    // A continuation path: next-event estimation here (weighed by MIS
+    // against the path's own sphere-light hits), then a phase-sampled
+    // direction followed by the path tracer from this vertex. Unbiased for
+    // all the light a path can reach; the caustic photons add the rest.
+    static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
+    Color Li = directLight(ctx, region, vertex, rng, kNextEvent);
+    const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+    Color weight(1);
+    float pdf;
+    const Vec3 wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
+    if (pdf > 0) {
+        const PathState state{scratch(ctx).pathDepth + 1, false, pdf, x};
+        if (!mChromatic) {
+            Li += weight * tracePath(ctx, Ray{x, wi}, region, -1, rng, state).L;
+        } else {  // one channel, picked uniformly: 3 times its radiance
+            const int c = std::min(2, int(rng.uniform() * 3));
+            Li[c] += 3 * weight[c] * tracePath(ctx, Ray{x, wi}, region, c, rng, state).L[c];
+        }
+    }
     if (il.indirect)
         Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
     return Li;

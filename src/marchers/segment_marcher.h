@@ -30,6 +30,9 @@ struct MarcherScratch final : ThreadContextExtension {
     bool measureOnly = false;
     double measuredGuided = 0;
     size_t measuredSegments = 0;  // segments through scattering media
+    // Scattering events of the camera path so far (diffuse bounces): a march
+    // sample is one more, and a continuation path starts from there.
+    int pathDepth = 0;
 };
 
 class SegmentMarcher : public Marcher {
@@ -43,10 +46,10 @@ protected:
     virtual bool marchSegment(ThreadContext& ctx, int region, const Ray& ray, float tEnd, Rng& rng, Color& L,
                               Color& beta) const = 0;
 
-    // L_i at x towards -rayDir: shadow rays to every light (direct light)
-    // plus the non-direct photons of eq. 4 (everything shadow rays cannot
-    // reach: multiple scattering, caustics); or, with render.li = "cache",
-    // the cached L_i alone. mp: the media at x (phase mixture).
+    // L_i at x towards -rayDir (eq. 3), by render.li: shadow rays to every
+    // light plus a continuation path and the caustic photons ("path"); or
+    // shadow rays plus the non-direct photons of eq. 4 ("photons"); or the
+    // cached L_i alone ("cache"). mp: the media at x (phase mixture).
     Color inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
                       Rng& rng) const;
 
@@ -63,6 +66,7 @@ protected:
 
     const Scene& mScene;
     std::shared_ptr<const Illumination> mIllumination;
+    const bool mChromatic;  // continuation paths track one channel
 };
 
 // One step of length dx in a medium with extinction kappa: its transmittance,

@@ -45,10 +45,18 @@ std::string methodList() {
     return s;
 }
 
-const char* liSourceName(LiSource s) { return s == LiSource::Cache ? "cache" : "photons"; }
+const char* liSourceName(LiSource s) {
+    switch (s) {
+        case LiSource::Path: return "path";
+        case LiSource::Photons: return "photons";
+        case LiSource::Cache: return "cache";
+    }
+    return "?";
+}
 
 bool parseLiSource(const std::string& name, LiSource& out) {
-    if (name == "photons") out = LiSource::Photons;
+    if (name == "path") out = LiSource::Path;
+    else if (name == "photons") out = LiSource::Photons;
     else if (name == "cache") out = LiSource::Cache;
     else return false;
     return true;

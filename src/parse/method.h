@@ -10,7 +10,12 @@ namespace vdbmarch {
 
 enum class Method { Uniform, Transmittance, Guided, Reference };
 enum class LiSource {
-    Photons,  // shadow rays for direct light plus the photon map's non-direct photons
+    // Shadow rays for direct light plus a continuation path (delta tracking,
+    // next-event estimation at every vertex) for the rest; photons only for
+    // what paths cannot find (caustics of delta lights through glass).
+    // Unbiased for everything else: the default.
+    Path,
+    Photons,  // shadow rays for direct light plus the photon map's non-direct photons (the paper's eq. 4)
     Cache,    // the radiance cache alone: a fast, biased preview
 };
 

@@ -73,7 +73,7 @@ struct RenderSettings {
     float exposure = 0;       // PNG preview, stops
     bool globalMajorant = false;  // reference: one majorant per grid (benchmarks only)
     // How the marchers estimate L_i at their samples.
-    LiSource li = LiSource::Photons;
+    LiSource li = LiSource::Path;
     int raySamples = 4;  // transmittance and guided: L_i samples per ray segment (mean for guided)
 };
 

@@ -282,7 +282,7 @@ RenderSettings parseRender(const JsonReader& r) {
     s.pixelJitter = r.boolean("pixel_jitter", s.pixelJitter);
     s.exposure = float(r.numberIn("exposure", 0, -64, 64));
     s.globalMajorant = r.choice("majorant", "local", {"local", "global"}) == "global";
-    parseLiSource(r.choice("li", liSourceName(s.li), {"photons", "cache"}), s.li);
+    parseLiSource(r.choice("li", liSourceName(s.li), {"path", "photons", "cache"}), s.li);
     s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
     return s;
 }

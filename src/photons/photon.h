@@ -44,20 +44,25 @@ inline Vec3 decodeDirection(uint32_t e) {
 }
 
 struct Photon {
-    enum Flags : uint32_t { Direct = 1u };  // straight from a light: shadow rays compute this light
+    enum Flags : uint32_t {
+        Direct = 1u,   // straight from a light: shadow rays compute this light
+        Caustic = 2u,  // from a delta light through a bending surface before any scattering:
+                       // no path with next-event estimation finds this light
+    };
     Vec3 position;
     uint32_t direction;  // encodeDirection(travel direction)
     Color weight;        // Phi / sigma_t at the collision (W m), per channel
-    uint32_t flags;      // bit 0: Direct; bits 16-31: the phase g there, as int16 / 32767
+    uint32_t flags;      // bit 0: Direct; bit 1: Caustic; bits 16-31: the phase g there, as int16 / 32767
 
     Vec3 travelDirection() const { return decodeDirection(direction); }
     bool isDirect() const { return (flags & Direct) != 0; }
+    bool isCaustic() const { return (flags & Caustic) != 0; }
     // Mean cosine of the phase function where the photon landed (the
     // sigma_s-weighted mean over the media there), for eq. 27's w'_l = g^l.
     float g() const { return float(int16_t(uint16_t(flags >> 16))) / 32767.f; }
-    static uint32_t packFlags(bool direct, float g) {
+    static uint32_t packFlags(bool direct, bool caustic, float g) {
         int q = int(std::lround(std::min(1.f, std::max(-1.f, g)) * 32767.f));
-        return (direct ? Direct : 0u) | (uint32_t(uint16_t(int16_t(q))) << 16);
+        return (direct ? Direct : 0u) | (caustic ? Caustic : 0u) | (uint32_t(uint16_t(int16_t(q))) << 16);
     }
 };
 static_assert(sizeof(Photon) == 32, "photons are stored compactly");

@@ -14,8 +14,7 @@ namespace vdbmarch {
 
 class PhotonMap {
 public:
-    // Takes the photons; builds the tree. `paths` is the number of photon
-    // paths they came from (for records only: their weights already carry 1/N).
+    // Takes the photons (their weights already carry 1 / paths); builds the tree.
     explicit PhotonMap(std::vector<Photon> photons);
     ~PhotonMap();
     PhotonMap(const PhotonMap&) = delete;

@@ -24,6 +24,7 @@ struct PhotonSource {
     std::unique_ptr<EmissionSampler> volume;  // emissive media
     int medium = -1;
     Color power{0, 0, 0};  // allocation weight
+    bool deltaLight = false;  // a point, spot, directional or collimated light
     size_t first = 0, count = 0;  // its range of path indices
 };
 
@@ -73,19 +74,21 @@ public:
             power = only;
             if (!(power[channel] > 0)) return;
         }
-        follow(ctx, ep.ray, power, channel, rng, out);
+        // Light emitted inside a medium is never direct: no shadow ray samples it.
+        follow(ctx, ep.ray, power, channel, !src.volume, src.deltaLight, rng, out);
     }
 
 private:
     // Follows a photon of power `power` from ray.o: stored at every real
     // collision in a medium (eq. 4), absorbed or scattered by the albedo,
     // surfaces by the shared surface event (importance transport).
-    void follow(ThreadContext& ctx, Ray ray, const Color& power, int channel, Rng& rng, std::vector<Photon>& out) const {
+    void follow(ThreadContext& ctx, Ray ray, const Color& power, int channel, bool direct, bool fromDeltaLight, Rng& rng,
+                std::vector<Photon>& out) const {
         const Scene& scene = mScene;
         const int maxDepth = scene.desc.render.maxDepth;
         int region = regionAtRayStart(scene, ray);
         int depth = 0, surfaceBounces = 0;
-        bool direct = true;
+        bool caustic = false;  // bent before its first scattering event, from a delta light
         Color beta(1);  // throughput relative to the emitted power
         MediumPoint mp;
         while (true) {
@@ -110,7 +113,7 @@ private:
                 ph.weight = power * beta / st;  // grey extinction: sigma_t is the same in every channel
                 float w[2];
                 mp.phase.legendreWeights(1, w);
-                ph.flags = Photon::packFlags(direct, w[1]);
+                ph.flags = Photon::packFlags(direct, caustic, w[1]);
                 out.push_back(ph);
                 if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
                     ended = true;
@@ -137,7 +140,12 @@ private:
             beta *= e.weight;
             // Index-matched glass is crossed straight, as shadow rays cross
             // it, so such photons stay direct.
-            if (!e.straight) direct = false;
+            if (!e.straight) {
+                // Paths find a delta light only by next-event estimation at a
+                // scattering vertex, through straight shadow rays.
+                if (direct && fromDeltaLight && e.kind != SurfaceEvent::Kind::Diffuse) caustic = true;
+                direct = false;
+            }
             if (!russianRoulette(beta, rng, ScatterRouletteThreshold)) return;
             ray = e.ray;
             region = e.region;
@@ -202,12 +210,13 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
 
     std::vector<PhotonSource> sources;
     for (const Light& l : scene.lights) {
-        PhotonSource s{PhotonEmitter::forLight(l, target), nullptr, -1, Color(0), 0, 0};
+        PhotonSource s{PhotonEmitter::forLight(l, target), nullptr, -1, Color(0), false, 0, 0};
         s.power = s.emitter.power();
+        s.deltaLight = l.isDelta();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }
     if (maxComponent(scene.background) > 0) {
-        PhotonSource s{PhotonEmitter::forEnvironment(scene.background, target), nullptr, -1, Color(0), 0, 0};
+        PhotonSource s{PhotonEmitter::forEnvironment(scene.background, target), nullptr, -1, Color(0), false, 0, 0};
         s.power = s.emitter.power();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }
@@ -216,7 +225,7 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
         if (!m.hasEmission) continue;
         auto sampler = m.makeEmissionSampler();
         if (!sampler) continue;
-        PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), 0, 0};
+        PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), false, 0, 0};
         s.power = m.sigma_a * m.emissionColor * (4 * Pi * sampler->integralEstimate());
         s.volume = std::move(sampler);
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
@@ -271,7 +280,10 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
         set.photons.insert(set.photons.end(), v.begin(), v.end());
         std::vector<Photon>().swap(v);
     }
-    for (const Photon& p : set.photons) set.directCount += p.isDirect();
+    for (const Photon& p : set.photons) {
+        set.directCount += p.isDirect();
+        set.causticCount += p.isCaustic();
+    }
     set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return set;
 }

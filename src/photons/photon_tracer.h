@@ -17,6 +17,7 @@ struct PhotonSet {
     std::vector<Photon> photons;
     size_t paths = 0;         // photon paths emitted (the N of the estimate)
     size_t directCount = 0;   // photons flagged Photon::Direct
+    size_t causticCount = 0;  // photons flagged Photon::Caustic
     Color emittedPower{0, 0, 0};
     double seconds = 0;
 };

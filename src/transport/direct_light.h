@@ -20,6 +20,13 @@ struct ScatterVertex {
     Vec3 n;  // surface only
     Color albedo{0, 0, 0};
 
+    static ScatterVertex inMedium(const Vec3& p, const Vec3& d, const PhaseMixture& phase) {
+        return {p, d, &phase, Vec3(0), Color(0)};
+    }
+    static ScatterVertex onSurface(const Vec3& p, const Vec3& d, const Vec3& n, const Color& albedo) {
+        return {p, d, nullptr, n, albedo};
+    }
+
     // f (phase, or albedo cos / pi) for light arriving from direction wi; 0
     // below a surface.
     Color f(const Vec3& wi) const;

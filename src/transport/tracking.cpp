@@ -25,7 +25,7 @@ void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, i
     if (media.size() == 1) {
         float k = coefficient(media[0]);
         mediumMajorants(ctx, media[0], r, tEnd, out);
-        for (auto& s : out) s.maxDensity *= k;
+        for (auto& s : out) s.maxDensity = mediumMajorant(s.maxDensity, k);
         return;
     }
     // Several media: sum their piecewise-constant majorants.
@@ -37,7 +37,7 @@ void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, i
         mediumMajorants(ctx, mi, r, tEnd, all);
         float k = coefficient(mi);
         for (size_t i = first; i < all.size(); ++i) {
-            all[i].maxDensity *= k;
+            all[i].maxDensity = mediumMajorant(all[i].maxDensity, k);
             cuts.push_back(all[i].t0);
             cuts.push_back(all[i].t1);
         }

@@ -4,16 +4,26 @@
 // handles each tentative collision.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "core/rng.h"
+#include "transport/media_point.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
 
 // Extinction used for tracking: channel c, or (grey media, channel < 0) channel 0.
 inline float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[channel < 0 ? 0 : channel]; }
+
+// A medium's extinction majorant from its density bound and coefficient.
+// evalMedia clamps each coefficient to MaxCoefficient, so the extinction
+// never exceeds twice that: the bound keeps huge inputs (density 1e30 x
+// sigma 1e30) finite, where an infinite majorant would stall tracking.
+inline float mediumMajorant(float maxDensity, float sigmaT) {
+    return std::min(maxDensity * sigmaT, 2 * MaxCoefficient);
+}
 
 // One medium's majorant segments (of its density) along [0, tEnd): local (per
 // VDB block) by default; with render.global_majorant, the grid's maximum over
@@ -48,7 +58,7 @@ void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int c
         const Medium& m = *ctx.scene.media[size_t(media[0])];
         const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
         ctx.queries[size_t(media[0])]->forEachMajorant(ray, 0.f, tEnd, [&](const MajorantSegment& s) {
-            return track({s.t0, s.t1, s.maxDensity * k});
+            return track({s.t0, s.t1, mediumMajorant(s.maxDensity, k)});
         });
     } else if (!media.empty()) {
         regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);

@@ -67,7 +67,7 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
         ctx.scratchSegments.clear();
         mediumMajorants(ctx, mi, r, tEnd, ctx.scratchSegments);
         for (const auto& seg : ctx.scratchSegments) {
-            const float sigmaMaj = seg.maxDensity * kMax;
+            const float sigmaMaj = mediumMajorant(seg.maxDensity, kMax);
             if (!(sigmaMaj > 0)) continue;
             double t = seg.t0;
             while (true) {

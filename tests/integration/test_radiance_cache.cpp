@@ -69,6 +69,64 @@ TEST(RadianceCache, CoefficientsAreEq27OfTheNearestPhotons) {
     EXPECT_GE(checked, 40);
 }
 
+TEST(RadianceCache, OverlappingMediaProjectTheirMixturesLegendreWeights) {
+    // Two media with different g fill the same box: the phase at a point is
+    // the sigma_s-weighted mixture, whose eq. 26 weights are
+    // sum_i w_i g_i^l, not the powers of its mean g. The expected truncated
+    // series takes w'_l = 2 pi Int p(u) P_l(u) du of the mixture by
+    // quadrature, independently of the code under test.
+    auto scene = sceneFromJson(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
+        "lights": [{"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "intensity": [20, 20, 20],
+                    "cone_deg": 12, "falloff_deg": 2}],
+        "media": [{"name": "fwd", "type": "homogeneous", "sigma_a": 0.1, "sigma_s": 1.0, "g": 0.8,
+                   "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}},
+                  {"name": "back", "type": "homogeneous", "sigma_a": 0.1, "sigma_s": 0.6, "g": -0.3,
+                   "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}],
+        "photons": {"count": 60000, "k": 40},
+        "cache": {"sh_order": 3, "quality": 1},
+        "render": {"max_depth": 2, "seed": 1}})");
+    BakeResult r = bake(*scene);
+    const RadianceCache& c = r.cache;
+    ASSERT_EQ(c.info.shOrder, 3);
+    const int K = c.info.shOrder;
+    auto mixture = [](double u) { return (1.0 * hgPhase(float(u), 0.8f) + 0.6 * hgPhase(float(u), -0.3f)) / 1.6; };
+    double w[MaxShOrder + 1];
+    for (int l = 0; l <= K; ++l) {
+        const int n = 200000;  // composite Simpson over u in [-1, 1]
+        double sum = 0, P[MaxShOrder + 1];
+        for (int i = 0; i <= n; ++i) {
+            const double u = -1 + 2.0 * i / n;
+            legendrePolynomials(K, u, P);
+            sum += (i == 0 || i == n ? 1 : (i % 2 ? 4 : 2)) * mixture(u) * P[l];
+        }
+        w[l] = 2 * M_PI * sum * (2.0 / n) / 3;
+    }
+    ASSERT_GT(std::fabs(w[2] - w[1] * w[1]), 0.1);  // the mean g's powers are far off
+    auto truncated = [&](float cosTheta) {
+        double P[MaxShOrder + 1];
+        legendrePolynomials(K, cosTheta, P);
+        double p = 0;
+        for (int l = 0; l <= K; ++l) p += (2 * l + 1) / (4 * M_PI) * w[l] * P[l];
+        return Color(float(p));
+    };
+    float Y[shCount(MaxShOrder)];
+    Rng rng(5);
+    int checked = 0;
+    for (size_t cell = 0; cell < c.cells.size(); ++cell) {
+        const Vec3 x = c.cellCenter(c.cells[cell]);
+        if (!(std::fabs(x.x) < 1 && std::fabs(x.y) < 1 && std::fabs(x.z) < 1)) continue;  // centres in both media
+        if (rng.uniform() > 0.1f) continue;
+        Vec3 wo = sampleUniformSphere(rng.uniform(), rng.uniform());
+        evalSh(K, wo, Y);
+        float cached = evalShSum(c.coefficientCount(), c.cellCoefficients(cell), Y);
+        float direct = average(r.photons->estimateLi(x, wo, size_t(c.info.k), truncated));
+        float bound = 4 * Pi * c.cellCoefficients(cell)[0] * 0.2820948f;  // float rounding, as above
+        EXPECT_NEAR(cached, direct, 2e-5f * bound + 1e-6f * std::fabs(direct)) << "cell " << cell;
+        ++checked;
+    }
+    EXPECT_GE(checked, 30);
+}
+
 TEST(RadianceCache, UniformGridFollowsThePapersRule) {
     auto scene = sceneFromJson(spotScene(0.f, false));
     BakeResult r = bake(*scene);

@@ -293,8 +293,11 @@ std::string writeBoxGrid(const std::string& path, const Index3& lo, const Index3
     return path;
 }
 
-std::string writeEmissiveBox(const std::string& path) {
-    writeGrids(path, {boxGrid(0, 19, 1.f, 0.05, "density"), boxGrid(-4, 24, 1.f, 0.05, "temperature")});
+std::string writeEmissiveBox(const std::string& path) { return writeEmissiveBox(path, 0, 19, 4, 0.05); }
+
+std::string writeEmissiveBox(const std::string& path, const Index3& lo, const Index3& hi, int margin, double h) {
+    const Index3 tlo(lo.x - margin, lo.y - margin, lo.z - margin), thi(hi.x + margin, hi.y + margin, hi.z + margin);
+    writeGrids(path, {boxGrid(lo, hi, 1.f, h, "density"), boxGrid(tlo, thi, 1.f, h, "temperature")});
     return path;
 }
 

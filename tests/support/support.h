@@ -232,6 +232,9 @@ std::string writeBoxGrid(const std::string& path, const Index3& lo, const Index3
 // A 20^3-voxel density box of 1 (voxel 0.05) inside a larger `temperature`
 // box of 1, so L_e is constant wherever the density is non-zero. Returns `path`.
 std::string writeEmissiveBox(const std::string& path);
+// The same for a density box [lo, hi] (voxel h) inside a temperature box
+// `margin` voxels larger on every side.
+std::string writeEmissiveBox(const std::string& path, const Index3& lo, const Index3& hi, int margin, double h);
 
 // Fixture geometry of writeVdbFixtures: voxel size 0.25, a 4x4x4 block of
 // voxels at index [-2, 1]^3, i.e. a cube of world edge 1 centred near the origin.

@@ -1,0 +1,125 @@
+#include "transport/path_tracer.h"
+
+#include "core/sampling.h"
+#include "transport/direct_light.h"
+#include "transport/media_point.h"
+#include "transport/roulette.h"
+#include "transport/surface_event.h"
+#include "transport/tracking.h"
+
+namespace vdbmarch {
+
+namespace {
+
+// Next-event estimation of the path: ratio tracking; sphere lights are also
+// hit by the path, the background only by the path.
+constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
+
+// Russian roulette on the throughput after RouletteMinDepth events.
+bool roulette(Color& beta, int depth, Rng& rng) {
+    return depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold);
+}
+
+}  // namespace
+
+bool hasChromaticExtinction(const Scene& scene) {
+    for (const auto& m : scene.media) {
+        const Color k = m->sigma_a + m->sigma_s;
+        if (k.x != k.y || k.y != k.z) return true;
+    }
+    return false;
+}
+
+PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState st) {
+    const Scene& scene = ctx.scene;
+    const int maxDepth = scene.desc.render.maxDepth;
+    const int startDepth = st.depth;
+    Color L(0), beta(1);
+    int surfaceBounces = 0;
+    MediumPoint mp;
+    while (true) {
+        SurfaceHit h;
+        bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
+        float tLight = Infinity;
+        int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
+        float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+
+        // Delta tracking to the next real collision, or to tEnd; the
+        // collision callback returns false once the path scattered or was absorbed.
+        bool scattered = false;
+        deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+            evalMedia(ctx, region, x, mp);
+            ++ctx.counters.marchSamples;
+            // Emission: sigma_a L_e / sigma_maj at every tentative collision.
+            if (!isBlack(mp.emission)) L += beta * mp.sigma_a * mp.emission / sigmaMaj;
+            float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
+            float u = rng.uniform() * sigmaMaj;
+            if (u < sa) {
+                beta = Color(0);  // absorbed
+                return false;
+            }
+            if (u >= sa + ss) return true;  // null collision
+            // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
+            beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+            ++st.depth;
+            if (st.depth > maxDepth) {
+                beta = Color(0);
+                return false;
+            }
+            L += beta * directLight(ctx, region, ScatterVertex::inMedium(x, ray.d, mp.phase), rng, kNextEvent);
+            float pdf;
+            const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+            Vec3 wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
+            st.lastPdf = pdf;
+            st.specular = false;
+            st.lastPoint = x;
+            ray = Ray{x, wi};
+            scattered = true;
+            return false;
+        });
+        if (isBlack(beta)) return {L, 0.f};
+        if (scattered) {
+            if (!roulette(beta, st.depth, rng)) return {L, 0.f};
+            continue;
+        }
+        // Reached tEnd without a real collision.
+        if (light >= 0) {
+            const Light& l = scene.lights[size_t(light)];
+            float w = 1;
+            if (!st.specular) {
+                // pdf with which next-event estimation at lastPoint would pick this direction
+                Vec3 to = l.desc().position - st.lastPoint;
+                float d2 = lengthSquared(to), r2 = l.desc().radius * l.desc().radius;
+                float sin2 = r2 / d2, cosMax = sin2 < 1e-6f ? 1 - 0.5f * sin2 : safeSqrt(1 - sin2);
+                w = powerHeuristic(st.lastPdf, uniformConePdf(cosMax));
+            }
+            L += beta * l.emittedRadiance() * w;
+            return {L, 0.f};
+        }
+        if (!hit) {
+            L += beta * scene.background;
+            return {L, st.depth == startDepth && surfaceBounces == 0 ? average(beta) : 0.f};
+        }
+        ++ctx.counters.surfaceHits;
+        if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return {L, 0.f};
+        const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
+        const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
+        if (e.kind == SurfaceEvent::Kind::Diffuse) {
+            ++st.depth;
+            if (st.depth > maxDepth) return {L, 0.f};
+            const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
+            L += beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, kNextEvent);
+            st.lastPdf = e.pdf;
+            st.specular = false;
+            st.lastPoint = h.p;
+        } else if (!e.straight) {
+            st.specular = true;  // next-event estimation cannot see through this
+        }
+        beta *= e.weight;
+        ray = e.ray;
+        region = e.region;
+        if (e.kind == SurfaceEvent::Kind::Diffuse && !roulette(beta, st.depth, rng)) return {L, 0.f};
+    }
+}
+
+}  // namespace vdbmarch

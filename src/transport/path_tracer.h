@@ -1,0 +1,47 @@
+// The volumetric path tracer's loop, written once for the reference method
+// (camera paths) and for the marchers' continuation estimate of L_i (paths
+// that start at a march sample):
+//  - free flights by delta tracking against local majorants (homogeneous
+//    media: exact exponential sampling), emission of eq. 1 collected at every
+//    tentative collision (sigma_a L_e / sigma_maj), absorption / scattering /
+//    null chosen by their ratios;
+//  - next-event estimation to every light at every scattering vertex with
+//    ratio-tracking transmittance; sphere lights are also hit by the path and
+//    the two strategies meet by the power heuristic;
+//  - phase-mixture sampling, the shared surface event, Russian roulette
+//    after RouletteMinDepth events; max_depth counts scattering events
+//    (media and diffuse surfaces).
+// Media whose extinction differs between RGB channels are tracked one
+// channel per path (`channel` >= 0), which keeps every estimator unbiased;
+// grey-extinction media share one path with RGB weights (channel < 0).
+#pragma once
+
+#include "core/rng.h"
+#include "transport/thread_context.h"
+
+namespace vdbmarch {
+
+// Where a path stands when the loop takes it over.
+struct PathState {
+    int depth = 0;           // scattering events so far
+    bool specular = true;    // the last direction was not sampled from a density (no MIS)
+    float lastPdf = 0;       // solid-angle pdf of that direction
+    Vec3 lastPoint{0, 0, 0};  // where it was sampled
+};
+
+struct PathRadiance {
+    Color L;              // radiance arriving at ray.o along -ray.d
+    float transmittance;  // fraction of the background seen straight (camera paths)
+};
+
+// The radiance the path ray (in `region`) brings back, from `state`.
+PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state);
+
+// True when some medium's extinction differs between channels.
+bool hasChromaticExtinction(const Scene& scene);
+
+// Tracking probabilities of the channel, or for grey extinction the channel
+// average (sigma_a + sigma_s sums to sigma_t either way).
+inline float trackedOrAverage(const Color& c, int channel) { return channel < 0 ? average(c) : c[channel]; }
+
+}  // namespace vdbmarch
