@@ -38,12 +38,12 @@ struct PowerFit {
     double timeFor(double rmse) const { return std::exp((std::log(rmse) - a) / b); }
 };
 
-PowerFit fit(const std::vector<BenchRow>& rows) {
+PowerFit fit(const std::vector<BenchRow>& rows, double BenchRow::*error = &BenchRow::rmse) {
     PowerFit f;
     double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
     for (const auto& r : rows) {
-        if (!(r.seconds > 0 && r.rmse > 0)) continue;
-        double x = std::log(r.seconds), y = std::log(r.rmse);
+        if (!(r.seconds > 0 && r.*error > 0)) continue;
+        double x = std::log(r.seconds), y = std::log(r.*error);
         n += 1;
         sx += x;
         sy += y;
@@ -252,6 +252,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
         row.relP50 = sp.p50;
         row.relP95 = sp.p95;
         row.relSpread = sp.ratio;
+        row.lowFreq = lowFrequencyError(img, reference);
         result.spreadEps = sp.eps;
         result.spreadPixels = sp.pixels;
     };
@@ -297,18 +298,18 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
             BenchRow row{method, budget, med.seconds, e.rmse, e.relMse, med.spp};
             measure(row, med.image);
             if (!o.stripPath.empty()) tiles[mi].push_back(makeTile(med.image));
-            std::fprintf(stderr, "bench: %-10s budget %-8g %4d spp %9.3f s  rmse %.5g  relmse %.5g  rel p95/p50 %.4g\n",
-                         method.c_str(), budget, row.spp, row.seconds, row.rmse, row.relMse, row.relSpread);
+            std::fprintf(stderr, "bench: %-10s budget %-8g %4d spp %9.3f s  rmse %.5g  relmse %.5g  LF %.4g  rel p95/p50 %.4g\n",
+                         method.c_str(), budget, row.spp, row.seconds, row.rmse, row.relMse, row.lowFreq, row.relSpread);
             result.rows.push_back(row);
         }
     }
 
     // CSV
     std::ostringstream csv;
-    csv << "method,budget,spp,seconds,rmse,relmse,rel_p50,rel_p95,rel_p95_over_p50\n";
+    csv << "method,budget,spp,seconds,rmse,relmse,rel_p50,rel_p95,rel_p95_over_p50,low_freq\n";
     for (const auto& r : result.rows)
         csv << r.method << "," << r.budget << "," << r.spp << "," << r.seconds << "," << r.rmse << "," << r.relMse
-            << "," << r.relP50 << "," << r.relP95 << "," << r.relSpread << "\n";
+            << "," << r.relP50 << "," << r.relP95 << "," << r.relSpread << "," << r.lowFreq << "\n";
     result.csvPath = o.outDir + "/bench.csv";
     writeTextFileAtomic(result.csvPath, csv.str());
 
@@ -318,11 +319,13 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     std::ostringstream md;
     md << "# vdbmarch bench\n\nReference image: `" << result.referenceImage << "`";
     if (result.referenceNoiseRmse > 0) md << " (its own estimated noise: RMSE " << result.referenceNoiseRmse << ")";
-    md << "\n\n| method | budget | spp | seconds | RMSE | relMSE | rel. error p50 | rel. error p95 | p95/p50 |\n"
-          "|---|---|---|---|---|---|---|---|---|\n";
+    md << "\n\n| method | budget | spp | seconds | RMSE | relMSE | LF error | rel. error p50 | rel. error p95 | p95/p50 |\n"
+          "|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : result.rows)
         md << "| " << r.method << " | " << r.budget << " | " << r.spp << " | " << r.seconds << " | " << r.rmse << " | "
-           << r.relMse << " | " << r.relP50 << " | " << r.relP95 << " | " << r.relSpread << " |\n";
+           << r.relMse << " | " << r.lowFreq << " | " << r.relP50 << " | " << r.relP95 << " | " << r.relSpread << " |\n";
+    md << "\nLF error: RMSE of 8x8 block means of the image and the reference, over the reference's mean: bias and "
+          "blotches show there, pixel noise averages out.\n";
     md << "\nPer-pixel relative error e = mean over RGB of |I - R| / (R + eps), eps = " << RelSpreadEpsilonFraction
        << " x the reference mean = " << result.spreadEps << ", over the " << result.spreadPixels
        << " pixels where the reference's alpha >= " << BenchSpreadMinAlpha
@@ -367,6 +370,27 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
             md << " " << ei / fits[j].at(tMid) << " | " << tMid / fits[j].timeFor(ei) << " |";
         }
         md << "\n";
+    }
+    // Convergence: the slopes of log error against log time, and the error at
+    // the largest budget over the error at the budget closest to a quarter of
+    // it (1/2 for noise falling as 1/sqrt(time); near 1: a plateau).
+    md << "\nConvergence per method: slopes b of RMSE and LF error against time (-0.5 for unbiased noise; near 0: "
+          "a plateau), and error at the last budget over error at a quarter of it:\n\n"
+          "| method | b (RMSE) | b (LF) | RMSE ratio | LF ratio | |\n|---|---|---|---|---|---|\n";
+    for (const auto& m : o.methods) {
+        std::vector<BenchRow> mine;
+        for (const auto& r : result.rows)
+            if (r.method == m) mine.push_back(r);
+        if (mine.size() < 2) continue;
+        const PowerFit fr = fit(mine), fl = fit(mine, &BenchRow::lowFreq);
+        const BenchRow& last = mine.back();
+        const BenchRow* quarter = &mine.front();
+        for (const auto& r : mine)
+            if (std::fabs(std::log(r.budget / (last.budget / 4))) < std::fabs(std::log(quarter->budget / (last.budget / 4))))
+                quarter = &r;
+        const double rr = last.rmse / quarter->rmse, lr = last.lowFreq / quarter->lowFreq;
+        md << "| " << m << " | " << (fr.ok ? str(fr.b) : "n/a") << " | " << (fl.ok ? str(fl.b) : "n/a") << " | " << rr
+           << " | " << lr << " | " << (rr > 0.6 || lr > 0.6 ? "**plateau** (ratio > 0.6)" : "converging") << " |\n";
     }
     if (!o.stripPath.empty()) {
         writeStrip(o.stripPath, tiles, stripColumns, o.stripReference, tileW, tileH, baseScene.render.exposure);

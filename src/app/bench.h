@@ -47,6 +47,9 @@ struct BenchRow {
     int spp = 0;
     // Per-pixel relative error percentiles (relativeErrorSpread in image/metrics.h).
     double relP50 = 0, relP95 = 0, relSpread = 0;  // relSpread = relP95 / relP50
+    // RMSE of 8x8 block means over the reference mean (lowFrequencyError):
+    // bias and blotches, not pixel noise.
+    double lowFreq = 0;
 };
 
 struct BenchResult {

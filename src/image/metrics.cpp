@@ -119,6 +119,40 @@ RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, fl
     return s;
 }
 
+double lowFrequencyError(const Image& test, const Image& reference, int block) {
+    if (test.width != reference.width || test.height != reference.height)
+        throw InputError(str("images differ in size: ", test.width, "x", test.height, " against ", reference.width, "x",
+                             reference.height));
+    double se = 0, refSum = 0;
+    size_t blocks = 0, pixels = 0;
+    for (int by = 0; by < reference.height; by += block)
+        for (int bx = 0; bx < reference.width; bx += block) {
+            double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+            int n = 0;
+            for (int y = by; y < std::min(by + block, reference.height); ++y)
+                for (int x = bx; x < std::min(bx + block, reference.width); ++x) {
+                    const Color ta = test.rgb(x, y), rb = reference.rgb(x, y);
+                    if (!isFinite(ta) || !isFinite(rb)) continue;
+                    for (int c = 0; c < 3; ++c) {
+                        a[c] += ta[c];
+                        b[c] += rb[c];
+                    }
+                    ++n;
+                }
+            if (n == 0) continue;
+            for (int c = 0; c < 3; ++c) {
+                const double d = (a[c] - b[c]) / n;
+                se += d * d;
+                refSum += b[c];
+            }
+            blocks += 3;
+            pixels += size_t(n);
+        }
+    const double mean = pixels ? refSum / (3.0 * double(pixels)) : 0.0;
+    if (!(mean > 0) || blocks == 0) return std::nan("");
+    return std::sqrt(se / double(blocks)) / mean;
+}
+
 void writeFalseColorDiff(const std::string& path, const Image& test, const Image& reference) {
     checkSameSize(test, reference);
     const size_t count = test.pixelCount();

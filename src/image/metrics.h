@@ -42,6 +42,13 @@ constexpr double RelSpreadEpsilonFraction = 1e-2;
 // Throws InputError if the sizes differ. With no pixel to compare, all NaN.
 RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, float minReferenceAlpha = 0.f);
 
+// Low-frequency error: both images averaged over blocks of `block` x `block`
+// pixels (per RGB channel; partial blocks at the edges too), the RMSE of the
+// block means over the reference's mean RGB value. Blotches and bias show
+// here; pixel noise averages out (by 1/block). NaN when the reference mean is
+// not positive. Throws InputError if the sizes differ.
+double lowFrequencyError(const Image& test, const Image& reference, int block = 8);
+
 // PNG of the per-pixel error |a-b| averaged over RGB, divided by its 99th
 // percentile (so a few fireflies do not wash out the rest) and mapped through
 // the viridis ramp: dark purple = no error, yellow = at or above the 99th
