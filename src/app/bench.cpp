@@ -217,6 +217,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
             reference = readExr(path);
             Image a = readExr(halfPath);
             result.referenceNoiseRmse = compareImages(a, reference).rmse;  // |A - mean| = |A - B| / 2
+            result.referenceNoiseLowFreq = lowFrequencyError(a, reference);
         } else {
             std::fprintf(stderr, "bench: rendering the reference (%d spp, method reference)...\n", o.referenceSpp);
             Image halves[2];
@@ -226,6 +227,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
             for (size_t i = 0; i < reference.rgba.size(); ++i)
                 reference.rgba[i] = 0.5f * (halves[0].rgba[i] + halves[1].rgba[i]);
             result.referenceNoiseRmse = compareImages(halves[0], reference).rmse;
+            result.referenceNoiseLowFreq = lowFrequencyError(halves[0], reference);
             writeExr(path, reference, {{"vdbmarch:method", "reference"}, {"vdbmarch:spp", std::to_string(o.referenceSpp)}});
             writeExr(halfPath, halves[0], {{"vdbmarch:method", "reference"}});
         }
@@ -318,7 +320,9 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     // the geometric mean of all measured times.
     std::ostringstream md;
     md << "# vdbmarch bench\n\nReference image: `" << result.referenceImage << "`";
-    if (result.referenceNoiseRmse > 0) md << " (its own estimated noise: RMSE " << result.referenceNoiseRmse << ")";
+    if (result.referenceNoiseRmse > 0)
+        md << " (its own estimated noise: RMSE " << result.referenceNoiseRmse << ", LF error "
+           << result.referenceNoiseLowFreq << ")";
     md << "\n\n| method | budget | spp | seconds | RMSE | relMSE | LF error | rel. error p50 | rel. error p95 | p95/p50 |\n"
           "|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : result.rows)
@@ -373,14 +377,22 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     }
     // Convergence: the slopes of log error against log time, and the error at
     // the largest budget over the error at the budget closest to a quarter of
-    // it (1/2 for noise falling as 1/sqrt(time); near 1: a plateau).
+    // it (1/2 for noise falling as 1/sqrt(time); near 1: a plateau). The
+    // reference's own noise is taken out in quadrature first, so that a
+    // method does not look stuck at the floor of an imperfect truth.
+    auto net = [](double e, double noise) { return std::sqrt(std::max(0.0, e * e - noise * noise)); };
     md << "\nConvergence per method: slopes b of RMSE and LF error against time (-0.5 for unbiased noise; near 0: "
-          "a plateau), and error at the last budget over error at a quarter of it:\n\n"
+          "a plateau), and error at the last budget over error at a quarter of it, both net of the reference's own "
+          "noise (subtracted in quadrature):\n\n"
           "| method | b (RMSE) | b (LF) | RMSE ratio | LF ratio | |\n|---|---|---|---|---|---|\n";
     for (const auto& m : o.methods) {
         std::vector<BenchRow> mine;
         for (const auto& r : result.rows)
-            if (r.method == m) mine.push_back(r);
+            if (r.method == m) {
+                mine.push_back(r);
+                mine.back().rmse = net(r.rmse, result.referenceNoiseRmse);
+                mine.back().lowFreq = net(r.lowFreq, result.referenceNoiseLowFreq);
+            }
         if (mine.size() < 2) continue;
         const PowerFit fr = fit(mine), fl = fit(mine, &BenchRow::lowFreq);
         const BenchRow& last = mine.back();

@@ -56,6 +56,7 @@ struct BenchResult {
     std::vector<BenchRow> rows;
     std::string referenceImage;     // which image served as reference
     double referenceNoiseRmse = 0;  // its own estimated noise (0 when given)
+    double referenceNoiseLowFreq = 0;  // ... as low-frequency error
     double spreadEps = 0;           // epsilon of the relative error
     size_t spreadPixels = 0;        // pixels the spread is measured over
     std::string csvPath, tablePath, plotPath;

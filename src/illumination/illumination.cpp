@@ -31,6 +31,7 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
     Illumination il;
     il.k = rq.photons.k;
     il.li = scene.desc.render.li;
+    il.pointLightsByPhotons = rq.pointLightsByPhotons;
     if (!sceneScatters(scene)) return il;  // no L_i anywhere: nothing to trace or cache
     bool needCache = rq.cache;
     if (needCache && !rq.cacheFile.empty()) {
@@ -48,12 +49,16 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
         st.photons = set.photons.size();
         st.directPhotons = set.directCount;
         const auto treeStart = Clock::now();
-        const size_t wanted = rq.causticsOnly ? set.causticCount : set.photons.size() - set.directCount;
-        if (rq.indirect && wanted > 0) {
+        auto wanted = [&](const Photon& p) {
+            return rq.causticsOnly ? p.isCaustic() || (p.isFromPointLight() && !p.isDirect()) : !p.isDirect();
+        };
+        size_t count = 0;
+        for (const Photon& p : set.photons) count += wanted(p);
+        if (rq.indirect && count > 0) {
             std::vector<Photon> indirect;
-            indirect.reserve(wanted);
+            indirect.reserve(count);
             for (const Photon& p : set.photons)
-                if (rq.causticsOnly ? p.isCaustic() : !p.isDirect()) indirect.push_back(p);
+                if (wanted(p)) indirect.push_back(p);
             il.indirect = std::make_unique<PhotonMap>(std::move(indirect));
             st.photonBytes += il.indirect->memoryBytes();
         }
@@ -103,14 +108,21 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // event, or pass refracting glass (a caustic, even for single
     // scattering). With paths, photons add only the caustics of delta
     // lights, which no path can find.
-    bool bendingGlass = false, deltaLight = false;
+    // Point and spot lights are the exception: next-event estimation at
+    // path vertices near them has unbounded variance (1/d^2), so photons
+    // carry their multiply scattered light too.
+    bool bendingGlass = false, deltaLight = false, pointLight = false;
     for (const SurfaceInfo& s : scene.surfaces)
         bendingGlass = bendingGlass || (s.material.type == MaterialDesc::Type::Dielectric && s.material.ior != 1.f);
-    for (const Light& l : scene.lights) deltaLight = deltaLight || l.isDelta();
+    for (const Light& l : scene.lights) {
+        deltaLight = deltaLight || l.isDelta();
+        pointLight = pointLight || l.isPointLike();
+    }
     if (rs.li == LiSource::Photons) rq.indirect = rs.maxDepth > 1 || bendingGlass;
     if (rs.li == LiSource::Path) {
-        rq.indirect = bendingGlass && deltaLight;
+        rq.indirect = (bendingGlass && deltaLight) || (pointLight && rs.maxDepth > 1);
         rq.causticsOnly = true;
+        rq.pointLightsByPhotons = pointLight && rq.indirect;
     }
     return rq;
 }

@@ -18,7 +18,9 @@ namespace vdbmarch {
 // What to build, and from which settings.
 struct IlluminationRequest {
     bool indirect = false;     // the map of photons for L_i beside shadow rays (and paths)
-    bool causticsOnly = false;  // ... only the caustic photons (render.li = "path")
+    // render.li = "path": only the caustic photons, and the non-direct ones
+    // of point and spot lights.
+    bool causticsOnly = false;
     bool cache = false;        // the radiance cache
     bool keepAllPhotons = false;  // keep the map of every photon (bake, tests)
     PhotonSettings photons;
@@ -26,6 +28,7 @@ struct IlluminationRequest {
     uint64_t renderSeed = 0;  // photons.seed falls back to it
     std::string cacheFile;    // load the cache from here instead of building it
     bool force = false;       // use a cache baked for another scene
+    bool pointLightsByPhotons = false;  // see Illumination
 };
 
 struct IlluminationStats {
@@ -43,6 +46,7 @@ struct Illumination {
     std::unique_ptr<PhotonMap> all;        // every photon, only with keepAllPhotons
     std::unique_ptr<RadianceCache> cache;  // null unless requested
     int k = 50;                            // photons per estimate
+    bool pointLightsByPhotons = false;     // "path": indirect carries point and spot lights' scattered light
     LiSource li = LiSource::Photons;
     IlluminationStats stats;
 };

@@ -100,7 +100,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     float pdf;
     const Vec3 wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
     if (pdf > 0) {
-        const PathState state{scratch(ctx).pathDepth + 1, false, pdf, x};
+        const PathState state{scratch(ctx).pathDepth + 1, false, pdf, x, il.pointLightsByPhotons};
         if (!mChromatic) {
             Li += weight * tracePath(ctx, Ray{x, wi}, region, -1, rng, state).L;
         } else {  // one channel, picked uniformly: 3 times its radiance

@@ -48,21 +48,24 @@ struct Photon {
         Direct = 1u,   // straight from a light: shadow rays compute this light
         Caustic = 2u,  // from a delta light through a bending surface before any scattering:
                        // no path with next-event estimation finds this light
+        FromPointLight = 4u,  // emitted by a point or spot light
     };
     Vec3 position;
     uint32_t direction;  // encodeDirection(travel direction)
     Color weight;        // Phi / sigma_t at the collision (W m), per channel
-    uint32_t flags;      // bit 0: Direct; bit 1: Caustic; bits 16-31: the phase g there, as int16 / 32767
+    uint32_t flags;      // bit 0: Direct; bit 1: Caustic; bit 2: FromPointLight; bits 16-31: the phase g there, as int16 / 32767
 
     Vec3 travelDirection() const { return decodeDirection(direction); }
     bool isDirect() const { return (flags & Direct) != 0; }
     bool isCaustic() const { return (flags & Caustic) != 0; }
+    bool isFromPointLight() const { return (flags & FromPointLight) != 0; }
     // Mean cosine of the phase function where the photon landed (the
     // sigma_s-weighted mean over the media there), for eq. 27's w'_l = g^l.
     float g() const { return float(int16_t(uint16_t(flags >> 16))) / 32767.f; }
-    static uint32_t packFlags(bool direct, bool caustic, float g) {
+    // bits: Flags or-ed together.
+    static uint32_t packFlags(uint32_t bits, float g) {
         int q = int(std::lround(std::min(1.f, std::max(-1.f, g)) * 32767.f));
-        return (direct ? Direct : 0u) | (caustic ? Caustic : 0u) | (uint32_t(uint16_t(int16_t(q))) << 16);
+        return (bits & 0xffffu) | (uint32_t(uint16_t(int16_t(q))) << 16);
     }
 };
 static_assert(sizeof(Photon) == 32, "photons are stored compactly");

@@ -25,6 +25,7 @@ struct PhotonSource {
     int medium = -1;
     Color power{0, 0, 0};  // allocation weight
     bool deltaLight = false;  // a point, spot, directional or collimated light
+    bool pointLight = false;  // a point or spot light
     size_t first = 0, count = 0;  // its range of path indices
 };
 
@@ -75,15 +76,15 @@ public:
             if (!(power[channel] > 0)) return;
         }
         // Light emitted inside a medium is never direct: no shadow ray samples it.
-        follow(ctx, ep.ray, power, channel, !src.volume, src.deltaLight, rng, out);
+        follow(ctx, ep.ray, power, channel, !src.volume, src, rng, out);
     }
 
 private:
     // Follows a photon of power `power` from ray.o: stored at every real
     // collision in a medium (eq. 4), absorbed or scattered by the albedo,
     // surfaces by the shared surface event (importance transport).
-    void follow(ThreadContext& ctx, Ray ray, const Color& power, int channel, bool direct, bool fromDeltaLight, Rng& rng,
-                std::vector<Photon>& out) const {
+    void follow(ThreadContext& ctx, Ray ray, const Color& power, int channel, bool direct, const PhotonSource& src,
+                Rng& rng, std::vector<Photon>& out) const {
         const Scene& scene = mScene;
         const int maxDepth = scene.desc.render.maxDepth;
         int region = regionAtRayStart(scene, ray);
@@ -113,7 +114,9 @@ private:
                 ph.weight = power * beta / st;  // grey extinction: sigma_t is the same in every channel
                 float w[2];
                 mp.phase.legendreWeights(1, w);
-                ph.flags = Photon::packFlags(direct, caustic, w[1]);
+                ph.flags = Photon::packFlags((direct ? Photon::Direct : 0u) | (caustic ? Photon::Caustic : 0u) |
+                                                 (src.pointLight ? Photon::FromPointLight : 0u),
+                                             w[1]);
                 out.push_back(ph);
                 if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
                     ended = true;
@@ -143,7 +146,7 @@ private:
             if (!e.straight) {
                 // Paths find a delta light only by next-event estimation at a
                 // scattering vertex, through straight shadow rays.
-                if (direct && fromDeltaLight && e.kind != SurfaceEvent::Kind::Diffuse) caustic = true;
+                if (direct && src.deltaLight && e.kind != SurfaceEvent::Kind::Diffuse) caustic = true;
                 direct = false;
             }
             if (!russianRoulette(beta, rng, ScatterRouletteThreshold)) return;
@@ -210,13 +213,14 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
 
     std::vector<PhotonSource> sources;
     for (const Light& l : scene.lights) {
-        PhotonSource s{PhotonEmitter::forLight(l, target), nullptr, -1, Color(0), false, 0, 0};
+        PhotonSource s{PhotonEmitter::forLight(l, target), nullptr, -1, Color(0), false, false, 0, 0};
         s.power = s.emitter.power();
         s.deltaLight = l.isDelta();
+        s.pointLight = l.isPointLike();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }
     if (maxComponent(scene.background) > 0) {
-        PhotonSource s{PhotonEmitter::forEnvironment(scene.background, target), nullptr, -1, Color(0), false, 0, 0};
+        PhotonSource s{PhotonEmitter::forEnvironment(scene.background, target), nullptr, -1, Color(0), false, false, 0, 0};
         s.power = s.emitter.power();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }
@@ -225,7 +229,7 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
         if (!m.hasEmission) continue;
         auto sampler = m.makeEmissionSampler();
         if (!sampler) continue;
-        PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), false, 0, 0};
+        PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), false, false, 0, 0};
         s.power = m.sigma_a * m.emissionColor * (4 * Pi * sampler->integralEstimate());
         s.volume = std::move(sampler);
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));

@@ -24,6 +24,9 @@ public:
     bool sample(const Vec3& x, float u1, float u2, LightSample& s) const;
     bool isDelta() const { return mDesc.type != LightDesc::Type::Sphere; }
     bool isSphere() const { return mDesc.type == LightDesc::Type::Sphere; }
+    // A point or spot light: its irradiance grows as 1/d^2 close to it, so
+    // next-event estimation at scattering vertices around it has unbounded variance.
+    bool isPointLike() const { return mDesc.type == LightDesc::Type::Point || mDesc.type == LightDesc::Type::Spot; }
     // Sphere lights only: nearest hit in (tMin, tMax).
     bool intersect(const Ray& r, float tMin, float tMax, float& t) const;
     // Radiance leaving a sphere light's surface: power / (4 pi^2 r^2).

@@ -30,6 +30,7 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         origin = v.p + nf * (1e-5f * std::max(scene.sceneScale, maxComponent(max(v.p, -v.p))));
     }
     for (const Light& light : scene.lights) {
+        if (o.skipPointLights && light.isPointLike()) continue;
         LightSample ls;
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;

@@ -41,6 +41,8 @@ struct DirectLightOptions {
     bool misWithPathHits = false;
     // The path does not go on: sample the constant background here (by f).
     bool sampleBackground = true;
+    // Leave point and spot lights out: photons carry their light here.
+    bool skipPointLights = false;
 };
 
 Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng, const DirectLightOptions& options);

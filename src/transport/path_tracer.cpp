@@ -13,7 +13,9 @@ namespace {
 
 // Next-event estimation of the path: ratio tracking; sphere lights are also
 // hit by the path, the background only by the path.
-constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
+DirectLightOptions nextEventOptions(const PathState& st) {
+    return {TransmittanceEstimator::RatioTracking, true, false, st.pointLightsByPhotons};
+}
 
 // Russian roulette on the throughput after RouletteMinDepth events.
 bool roulette(Color& beta, int depth, Rng& rng) {
@@ -66,7 +68,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 beta = Color(0);
                 return false;
             }
-            L += beta * directLight(ctx, region, ScatterVertex::inMedium(x, ray.d, mp.phase), rng, kNextEvent);
+            L += beta * directLight(ctx, region, ScatterVertex::inMedium(x, ray.d, mp.phase), rng, nextEventOptions(st));
             float pdf;
             const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
             Vec3 wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
@@ -108,7 +110,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             ++st.depth;
             if (st.depth > maxDepth) return {L, 0.f};
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            L += beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, kNextEvent);
+            L += beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, nextEventOptions(st));
             st.lastPdf = e.pdf;
             st.specular = false;
             st.lastPoint = h.p;

@@ -27,6 +27,9 @@ struct PathState {
     bool specular = true;    // the last direction was not sampled from a density (no MIS)
     float lastPdf = 0;       // solid-angle pdf of that direction
     Vec3 lastPoint{0, 0, 0};  // where it was sampled
+    // Next-event estimation leaves point and spot lights out (photons carry
+    // their multiply scattered light: near them it has unbounded variance).
+    bool pointLightsByPhotons = false;
 };
 
 struct PathRadiance {

@@ -131,11 +131,13 @@ TEST(Bench, WritesAnImageStripOfMethodsByBudgets) {
             differ = strip.rgb(x1 + x, y).x != strip.rgb(x1 + x, 12 + StripSeparator + y).x;
     EXPECT_TRUE(differ);
 
-    // The spread columns follow the existing ones.
+    // The spread and low-frequency columns follow the existing ones.
     std::string csv = readBytes(r.csvPath);
-    EXPECT_EQ(csv.substr(0, csv.find('\n')), "method,budget,spp,seconds,rmse,relmse,rel_p50,rel_p95,rel_p95_over_p50");
+    EXPECT_EQ(csv.substr(0, csv.find('\n')),
+              "method,budget,spp,seconds,rmse,relmse,rel_p50,rel_p95,rel_p95_over_p50,low_freq");
     std::string md = readBytes(r.tablePath);
-    EXPECT_NE(md.find("| RMSE | relMSE | rel. error p50 | rel. error p95 | p95/p50 |"), std::string::npos);
+    EXPECT_NE(md.find("| RMSE | relMSE | LF error | rel. error p50 | rel. error p95 | p95/p50 |"), std::string::npos);
+    EXPECT_NE(md.find("| method | b (RMSE) | b (LF) | RMSE ratio | LF ratio |"), std::string::npos);
     EXPECT_NE(md.find("strip.png"), std::string::npos);
     EXPECT_GT(r.spreadPixels, 0u);
     EXPECT_LT(r.spreadPixels, size_t(16 * 12));  // the sky around the cloud is left out
@@ -143,6 +145,7 @@ TEST(Bench, WritesAnImageStripOfMethodsByBudgets) {
         EXPECT_GT(row.relP50, 0) << row.method;
         EXPECT_GE(row.relP95, row.relP50) << row.method;
         EXPECT_DOUBLE_EQ(row.relSpread, row.relP95 / row.relP50) << row.method;
+        EXPECT_GT(row.lowFreq, 0) << row.method;
     }
 
     // Narrower than the images: tiles are box-downscaled to fit; no reference column.

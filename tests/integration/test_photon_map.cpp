@@ -183,13 +183,14 @@ TEST(PhotonStorage, CompactDirectionAndPhase) {
     }
     for (float g : {-0.999f, -0.3f, 0.f, 0.85f, 0.999f}) {
         Photon p{};
-        p.flags = Photon::packFlags(true, false, g);
+        p.flags = Photon::packFlags(Photon::Direct, g);
         EXPECT_TRUE(p.isDirect());
         EXPECT_FALSE(p.isCaustic());
         EXPECT_NEAR(p.g(), g, 1.f / 32767);
-        p.flags = Photon::packFlags(false, true, g);
+        p.flags = Photon::packFlags(Photon::Caustic | Photon::FromPointLight, g);
         EXPECT_FALSE(p.isDirect());
         EXPECT_TRUE(p.isCaustic());
+        EXPECT_TRUE(p.isFromPointLight());
         EXPECT_NEAR(p.g(), g, 1.f / 32767);
     }
 }
