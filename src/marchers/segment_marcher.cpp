@@ -12,6 +12,13 @@ namespace vdbmarch {
 
 SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination)
     : mScene(scene), mIllumination(std::move(illumination)), mChromatic(hasChromaticExtinction(scene)) {
+    // Without emissive media or refracting glass, the light arriving at a
+    // sample straight from its first direction is what next-event estimation
+    // samples (lights and the background).
+    mLastEventByNextEvent = true;
+    for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
+    for (const SurfaceInfo& si : scene.surfaces)
+        if (si.material.type == MaterialDesc::Type::Dielectric && si.material.ior != 1.f) mLastEventByNextEvent = false;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
 }
 
@@ -93,6 +100,17 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     // against the path's own sphere-light hits), then a phase-sampled
     // direction followed by the path tracer from this vertex. Unbiased for
     // all the light a path can reach; the caustic photons add the rest.
+    const int depth = scratch(ctx).pathDepth + 1;  // this sample's scattering event
+    if (depth >= mScene.desc.render.maxDepth && mLastEventByNextEvent) {
+        // The last event max_depth allows: a path from here could only find
+        // lights and the background straight along its first direction,
+        // which next-event estimation samples directly (no path needed).
+        static constexpr DirectLightOptions kLastEvent{TransmittanceEstimator::RatioTracking, false, true};
+        Color Li = directLight(ctx, region, vertex, rng, kLastEvent);
+        if (il.indirect)
+            Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
+        return Li;
+    }
     static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
     Color Li = directLight(ctx, region, vertex, rng, kNextEvent);
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
@@ -100,7 +118,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     float pdf;
     const Vec3 wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
     if (pdf > 0) {
-        const PathState state{scratch(ctx).pathDepth + 1, false, pdf, x, il.pointLightsByPhotons};
+        const PathState state{depth, false, pdf, x, il.pointLightsByPhotons};
         if (!mChromatic) {
             Li += weight * tracePath(ctx, Ray{x, wi}, region, -1, rng, state).L;
         } else {  // one channel, picked uniformly: 3 times its radiance

@@ -67,6 +67,7 @@ protected:
     const Scene& mScene;
     std::shared_ptr<const Illumination> mIllumination;
     const bool mChromatic;  // continuation paths track one channel
+    bool mLastEventByNextEvent = true;  // see the constructor
 };
 
 // One step of length dx in a medium with extinction kappa: its transmittance,
