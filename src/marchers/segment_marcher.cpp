@@ -79,7 +79,7 @@ CacheLookup& SegmentMarcher::cacheLookup(ThreadContext& ctx) const {
 }
 
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
-                                  const MediumPoint& mp, Rng& rng) const {
+                                  const MediumPoint& mp, Rng& rng, float pathProbability) const {
     if (!mp.scatters()) return Color(0);
     ++ctx.counters.liSamples;
     const Illumination& il = *mIllumination;
@@ -113,11 +113,12 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     }
     static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
     Color Li = directLight(ctx, region, vertex, rng, kNextEvent);
+    const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-    Color weight(1);
-    float pdf;
+    Color weight(tracePathHere ? 1 / std::min(1.f, pathProbability) : 0.f);
+    float pdf = 0;
     const Vec3 wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
-    if (pdf > 0) {
+    if (tracePathHere && pdf > 0) {
         const PathState state{depth, false, pdf, x, il.pointLightsByPhotons};
         if (!mChromatic) {
             Li += weight * tracePath(ctx, Ray{x, wi}, region, -1, rng, state).L;

@@ -50,8 +50,11 @@ protected:
     // light plus a continuation path and the caustic photons ("path"); or
     // shadow rays plus the non-direct photons of eq. 4 ("photons"); or the
     // cached L_i alone ("cache"). mp: the media at x (phase mixture).
+    // `pathProbability`: with "path", the continuation path is traced with
+    // this probability and weighted by its inverse (Russian roulette), so a
+    // marcher that estimates L_i at every step bounds its paths per ray.
     Color inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
-                      Rng& rng) const;
+                      Rng& rng, float pathProbability = 1) const;
 
     // The active intervals of [0, tEnd) (empty space skipped) into
     // ctx.intervals; false when the region holds no media. A ray into

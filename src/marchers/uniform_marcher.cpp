@@ -7,6 +7,7 @@
 // and T_{k+1} = T_k e^{-kappa dx}. S replaces eq. 5's dx so optically thick
 // steps cannot over-count (S -> dx as kappa dx -> 0). S sigma_x is evaluated as
 // (1 - e^{-kappa dx}) (sigma_x / kappa) so that no product can overflow.
+#include <algorithm>
 #include <cmath>
 
 #include "marchers/segment_marcher.h"
@@ -28,6 +29,13 @@ private:
         if (!activeIntervals(ctx, region, ray, tEnd, infiniteTail)) return true;
         const float dx = scene.step;
         const float u = rng.uniform();  // one random offset per segment (eq. 5 with jitter)
+        // L_i at every step, but continuation paths (render.li = "path") at
+        // render.ray_samples of the segment's steps on average, as the
+        // sampled marchers take: each step traces one with probability q.
+        double activeLength = 0;
+        for (const Interval& iv : ctx.intervals) activeLength += double(std::min(iv.t1, 1e30f) - iv.t0);
+        const float q = activeLength > 0 ? float(std::min(1.0, double(scene.desc.render.raySamples) * dx / activeLength))
+                                         : 1.f;
         MediumPoint mp;
         for (const Interval& iv : ctx.intervals) {
             // Lattice index in double: k + 1 must never round back to k.
@@ -37,7 +45,7 @@ private:
                 evalMedia(ctx, region, x, mp);
                 ++ctx.counters.marchSamples;
                 if (isBlack(mp.sigma_t)) continue;
-                Color Li = inScattered(ctx, region, x, ray.d, mp, rng);
+                Color Li = inScattered(ctx, region, x, ray.d, mp, rng, q);
                 StepTerms st = stepTerms(mp, dx);
                 L += beta * (st.absorbedA * mp.emission + st.absorbedS * Li);
                 beta *= st.T;
