@@ -5,6 +5,7 @@
 #include "cache/cache_build.h"
 #include "core/error.h"
 #include "photons/photon_tracer.h"
+#include "transport/surface_event.h"
 
 namespace vdbmarch {
 
@@ -111,9 +112,8 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // Point and spot lights are the exception: next-event estimation at
     // path vertices near them has unbounded variance (1/d^2), so photons
     // carry their multiply scattered light too.
-    bool bendingGlass = false, deltaLight = false, pointLight = false;
-    for (const SurfaceInfo& s : scene.surfaces)
-        bendingGlass = bendingGlass || (s.material.type == MaterialDesc::Type::Dielectric && s.material.ior != 1.f);
+    const bool bendingGlass = hasBendingGlass(scene);
+    bool deltaLight = false, pointLight = false;
     for (const Light& l : scene.lights) {
         deltaLight = deltaLight || l.isDelta();
         pointLight = pointLight || l.isPointLike();

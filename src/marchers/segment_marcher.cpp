@@ -15,10 +15,8 @@ SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumin
     // Without emissive media or refracting glass, the light arriving at a
     // sample straight from its first direction is what next-event estimation
     // samples (lights and the background).
-    mLastEventByNextEvent = true;
+    mLastEventByNextEvent = !hasBendingGlass(scene);
     for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
-    for (const SurfaceInfo& si : scene.surfaces)
-        if (si.material.type == MaterialDesc::Type::Dielectric && si.material.ior != 1.f) mLastEventByNextEvent = false;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
 }
 
@@ -90,12 +88,12 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         return Color(c.at(x));
     }
     const ScatterVertex vertex = ScatterVertex::inMedium(x, rayDir, mp.phase);
-    if (il.li == LiSource::Photons) {
-        Color Li = directLight(ctx, region, vertex, rng, {});
-        if (il.indirect)
-            Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
-        return Li;
-    }
+    // Eq. 4 over the photons the L_i source keeps (none: no photon map).
+    auto photons = [&] {
+        if (!il.indirect) return Color(0);
+        return il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
+    };
+    if (il.li == LiSource::Photons) return directLight(ctx, region, vertex, rng, {}) + photons();
     // A continuation path: next-event estimation here (weighed by MIS
     // against the path's own sphere-light hits), then a phase-sampled
     // direction followed by the path tracer from this vertex. Unbiased for
@@ -106,30 +104,25 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         // lights and the background straight along its first direction,
         // which next-event estimation samples directly (no path needed).
         static constexpr DirectLightOptions kLastEvent{TransmittanceEstimator::RatioTracking, false, true};
-        Color Li = directLight(ctx, region, vertex, rng, kLastEvent);
-        if (il.indirect)
-            Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
-        return Li;
+        return directLight(ctx, region, vertex, rng, kLastEvent) + photons();
     }
     static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
     Color Li = directLight(ctx, region, vertex, rng, kNextEvent);
     const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-    Color weight(tracePathHere ? 1 / std::min(1.f, pathProbability) : 0.f);
-    float pdf = 0;
-    const Vec3 wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
-    if (tracePathHere && pdf > 0) {
+    if (tracePathHere) {
+        Color weight(1 / std::min(1.f, pathProbability));
+        float pdf = 0;
+        const Vec3 wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
         const PathState state{depth, false, pdf, x, il.pointLightsByPhotons};
-        if (!mChromatic) {
+        if (pdf > 0 && !mChromatic) {
             Li += weight * tracePath(ctx, Ray{x, wi}, region, -1, rng, state).L;
-        } else {  // one channel, picked uniformly: 3 times its radiance
+        } else if (pdf > 0) {  // one channel, picked uniformly: 3 times its radiance
             const int c = std::min(2, int(rng.uniform() * 3));
             Li[c] += 3 * weight[c] * tracePath(ctx, Ray{x, wi}, region, c, rng, state).L[c];
         }
     }
-    if (il.indirect)
-        Li += il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
-    return Li;
+    return Li + photons();
 }
 
 namespace {

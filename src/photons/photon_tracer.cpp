@@ -9,6 +9,7 @@
 
 #include "core/sampling.h"
 #include "transport/media_point.h"
+#include "transport/path_tracer.h"
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
@@ -37,12 +38,8 @@ constexpr size_t ChunkPaths = 2048;
 
 class PhotonTracer {
 public:
-    PhotonTracer(const Scene& scene, uint64_t seed) : mScene(scene), mSeed(seed) {
-        for (const auto& m : scene.media) {
-            Color k = m->sigma_a + m->sigma_s;
-            mChromatic = mChromatic || k.x != k.y || k.y != k.z;
-        }
-    }
+    PhotonTracer(const Scene& scene, uint64_t seed)
+        : mScene(scene), mSeed(seed), mChromatic(hasChromaticExtinction(scene)) {}
 
     // Traces path `index` of `source`, appending its photons.
     void tracePath(ThreadContext& ctx, const PhotonSource& src, size_t index, std::vector<Photon>& out) const {
@@ -104,8 +101,7 @@ private:
             bool scattered = false, ended = false;
             deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
                 evalMedia(ctx, region, x, mp);
-                float sa = channel < 0 ? average(mp.sigma_a) : mp.sigma_a[channel];
-                float ss = channel < 0 ? average(mp.sigma_s) : mp.sigma_s[channel];
+                float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
                 if (rng.uniform() * sigmaMaj >= sa + ss) return true;  // null collision
                 float st = sa + ss;
                 Photon ph;
@@ -157,7 +153,7 @@ private:
 
     const Scene& mScene;
     uint64_t mSeed;
-    bool mChromatic = false;
+    const bool mChromatic;
 };
 
 }  // namespace

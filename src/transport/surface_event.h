@@ -35,6 +35,10 @@ SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& hit, const
 // index-matched glass); every other surface blocks it.
 bool crossedByShadowRays(const MaterialDesc& material);
 
+// True when some surface refracts or reflects (a dielectric with ior != 1):
+// light that passes it cannot be followed by shadow rays.
+bool hasBendingGlass(const Scene& scene);
+
 // Offset origin for a ray leaving a surface at p in direction d.
 Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d);
 
