@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cache/product_sampler.h"
 #include "cache/sh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -133,6 +134,80 @@ void BM_EvalSh(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()));
 }
 BENCHMARK(BM_EvalSh)->Arg(3)->Arg(8);
+
+// Product sampling of the continuation direction (cache/product_sampler.h),
+// order 3: one build per path continuation (the table of phase x cached
+// radiance), one sample from it, and plain phase sampling for comparison.
+// Inputs cycle over 256 ray directions and coefficient sets.
+struct ProductInputs {
+    std::vector<Vec3> rays;
+    std::vector<float> coeffs;  // 16 per set
+    PhaseMixture phase;
+    ProductInputs() {
+        Rng rng(9);
+        phase.add(Color(1), 0.6f);
+        for (int i = 0; i < 256; ++i) {
+            rays.push_back(sampleUniformSphere(rng.uniform(), rng.uniform()));
+            // A photon-like lobe (delta projection) plus some ambient light.
+            float Y[16];
+            evalSh(3, sampleUniformSphere(rng.uniform(), rng.uniform()), Y);
+            for (int k = 0; k < 16; ++k) coeffs.push_back(Y[k] + (k == 0 ? 0.3f : 0.f));
+        }
+    }
+};
+
+void BM_ProductSamplerBuild(benchmark::State& state) {
+    const ProductInputs in;
+    ProductDirectionSampler s;
+    size_t i = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(s.build(3, &in.coeffs[16 * i], in.phase, in.rays[i]));
+        benchmark::ClobberMemory();
+        i = (i + 1) & 255;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_ProductSamplerBuild);
+
+void BM_ProductSamplerSample(benchmark::State& state) {
+    const ProductInputs in;
+    ProductDirectionSampler s;
+    s.build(3, in.coeffs.data(), in.phase, in.rays[0]);
+    Rng rng(2);
+    for (auto _ : state) benchmark::DoNotOptimize(s.sample(rng.uniform(), rng.uniform(), rng.uniform()));
+    state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_ProductSamplerSample);
+
+void BM_ProductSamplerBuildAndSample(benchmark::State& state) {
+    const ProductInputs in;
+    ProductDirectionSampler s;
+    Rng rng(2);
+    size_t i = 0;
+    for (auto _ : state) {
+        s.build(3, &in.coeffs[16 * i], in.phase, in.rays[i]);
+        benchmark::DoNotOptimize(s.sample(rng.uniform(), rng.uniform(), rng.uniform()));
+        i = (i + 1) & 255;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_ProductSamplerBuildAndSample);
+
+// What the continuation does today: PhaseMixture::sample around the ray.
+void BM_PhaseMixtureSample(benchmark::State& state) {
+    const ProductInputs in;
+    Rng rng(2);
+    size_t i = 0;
+    for (auto _ : state) {
+        Color w(1);
+        float pdf;
+        benchmark::DoNotOptimize(in.phase.sample(in.rays[i], rng.uniform(), rng.uniform(), rng.uniform(), w, pdf));
+        benchmark::DoNotOptimize(w);
+        i = (i + 1) & 255;
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_PhaseMixtureSample);
 
 // ---------------------------------------------------------------------------
 // Issue 5: the cost of one march sample against one trilinear density lookup

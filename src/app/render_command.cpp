@@ -28,8 +28,9 @@ const SceneOptionTable<RenderArgs>& renderSceneOptions() {
         {"--step", "render.step", "March step in world units (default: one voxel)", &RenderArgs::step},
         {"--exposure", "render.exposure", "PNG exposure in stops", &RenderArgs::exposure},
         {"--li", "render.li",
-         "How marchers estimate L_i: photons (shadow rays + non-direct photons, default) or cache "
-         "(the radiance cache alone: fast, biased preview)",
+         "How marchers estimate L_i: path (next-event estimation + a continuation path, and photons for "
+         "caustics; default), photons (shadow rays + non-direct photons: the paper) or cache (the radiance "
+         "cache alone: fast, biased preview)",
          &RenderArgs::li},
         {"--ray-samples", "render.ray_samples",
          "L_i samples per ray segment for transmittance and guided (render.ray_samples)", &RenderArgs::raySamples},
@@ -73,6 +74,7 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"photons_and_cache", r.illuminationSeconds},
                     {"total", total}};
     s["photons"] = r.photons;
+    s["photon_passes"] = r.photonPasses;
     s["cache_cells"] = r.cacheCells;
     s["threads"] = r.threads;
     s["method"] = methodName(desc.render.method);
@@ -124,6 +126,7 @@ int runRender(const RenderArgs& a) {
         {"vdbmarch:source", desc.file},
         {"vdbmarch:method", methodName(desc.render.method)},
         {"vdbmarch:spp", std::to_string(r.spp)},
+        {"vdbmarch:photonPasses", std::to_string(r.photonPasses)},
         {"vdbmarch:timeBudget", a.timeBudget ? str(*a.timeBudget) : std::string("none")},
         {"vdbmarch:seed", std::to_string(desc.render.seed)},
         {"vdbmarch:step", str(scene->step)},
@@ -141,7 +144,8 @@ int runRender(const RenderArgs& a) {
                      r.image.width, r.image.height, r.spp, methodName(desc.render.method), double(scene->step),
                      r.seconds,
                      r.illuminationSeconds > 0
-                         ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s, ").c_str()
+                         ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s in ",
+                               r.photonPasses, r.photonPasses == 1 ? " pass, " : " passes, ").c_str()
                          : "",
                      loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
     return 0;

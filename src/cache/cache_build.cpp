@@ -119,6 +119,69 @@ LevelCounts countPhotons(const PhotonMap& map, const Vec3& origin, float h) {
 
 }  // namespace
 
+namespace {
+// Eq. 27 at every cell of `cache` (its topology) from `map`; with
+// cache.incidentOrder >= 0 also the non-direct incident radiance into
+// `incident` (same k nearest photons and sphere).
+std::vector<float> estimateCoefficients(const Scene& scene, const PhotonMap& map, const RadianceCache& cache,
+                                        int kNearest, std::vector<float>& incident) {
+    // Eq. 27 at every cell centre from its k nearest photons, with the
+    // Legendre weights of the phase mixture at the centre (eq. 26: sum_i
+    // w_i g_i^l where media overlap), as eq. 4 takes the phase at the point
+    // it estimates. A centre where nothing scatters (a cell across a
+    // medium's edge) takes each photon's own mean g^l.
+    const int order = cache.info.shOrder, count = cache.coefficientCount();
+    const size_t kk = size_t(std::min(kNearest, 1024));
+    std::vector<float> coefficients(cache.cells.size() * size_t(count), 0.f);
+    const int incidentOrder = cache.incidentOrder, incidentCount = incidentOrder >= 0 ? shCount(incidentOrder) : 0;
+    incident.assign(cache.cells.size() * size_t(incidentCount), 0.f);
+    tbb::enumerable_thread_specific<ThreadContext> contexts([&] { return ThreadContext(scene); });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cache.cells.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        ThreadContext& ctx = contexts.local();
+        std::vector<uint32_t> idx(kk);
+        std::vector<float> d2(kk);
+        float Y[shCount(MaxShOrder)], w[MaxShOrder + 1], Yi[shCount(MaxShOrder)];
+        MediumPoint mp;
+        for (size_t c = r.begin(); c < r.end(); ++c) {
+            const Vec3 x = cache.cellCenter(cache.cells[c]);
+            size_t n = map.nearest(x, kk, idx.data(), d2.data());
+            if (n == 0 || !(d2[n - 1] > 0)) continue;
+            float* f = &coefficients[c * size_t(count)];
+            bool centreScatters = false;
+            if (order > 0) {
+                evalMedia(ctx, regionAtRayStart(scene, Ray{x, Vec3(0, 0, 1)}), x, mp);
+                centreScatters = mp.scatters();
+                if (centreScatters) mp.phase.legendreWeights(order, w);
+            }
+            float* fi = incidentCount > 0 ? &incident[c * size_t(incidentCount)] : nullptr;
+            for (size_t i = 0; i + 1 < n; ++i) {  // the farthest only sets the radius
+                const Photon& p = map[idx[i]];
+                float weight = average(p.weight);
+                if (fi && !p.isDirect()) {
+                    evalSh(incidentOrder, p.travelDirection(), Yi);
+                    for (int j = 0; j < incidentCount; ++j) fi[j] += weight * Yi[j];
+                }
+                if (order == 0) {
+                    f[0] += weight;
+                    continue;
+                }
+                evalSh(order, p.travelDirection(), Y);
+                if (!centreScatters) hgLegendreWeights(order, p.g(), w);
+                for (int l = 0; l <= order; ++l)
+                    for (int m = -l; m <= l; ++m) f[shIndex(l, m)] += weight * w[l] * Y[shIndex(l, m)];
+            }
+            float r2 = d2[n - 1];
+            float invVolume = 1 / (4.f / 3.f * Pi * r2 * std::sqrt(r2));
+            // Order 0: Y_00 = 1 / sqrt(4 pi) and w'_0 = 1.
+            if (order == 0) f[0] *= 0.28209479f;
+            for (int i = 0; i < count; ++i) f[i] *= invVolume;
+            for (int i = 0; i < incidentCount; ++i) fi[i] *= invVolume;
+        }
+    });
+    return coefficients;
+}
+}  // namespace
+
 int effectiveShOrder(const Scene& scene, int requested) {
     for (const auto& m : scene.media)
         if (!m->isVacuum() && !isBlack(m->sigma_s) && m->g != 0) return requested;
@@ -219,52 +282,9 @@ RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_
     }
     double topologySeconds = secondsSince(start);
 
-    // Eq. 27 at every cell centre from its k nearest photons, with the
-    // Legendre weights of the phase mixture at the centre (eq. 26: sum_i
-    // w_i g_i^l where media overlap), as eq. 4 takes the phase at the point
-    // it estimates. A centre where nothing scatters (a cell across a
-    // medium's edge) takes each photon's own mean g^l.
     auto estimateStart = Clock::now();
-    const int order = cache.info.shOrder, count = cache.coefficientCount();
-    const size_t kk = size_t(std::min(kNearest, 1024));
-    cache.coefficients.assign(cache.cells.size() * size_t(count), 0.f);
-    tbb::enumerable_thread_specific<ThreadContext> contexts([&] { return ThreadContext(scene); });
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, cache.cells.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        ThreadContext& ctx = contexts.local();
-        std::vector<uint32_t> idx(kk);
-        std::vector<float> d2(kk);
-        float Y[shCount(MaxShOrder)], w[MaxShOrder + 1];
-        MediumPoint mp;
-        for (size_t c = r.begin(); c < r.end(); ++c) {
-            const Vec3 x = cache.cellCenter(cache.cells[c]);
-            size_t n = map.nearest(x, kk, idx.data(), d2.data());
-            if (n == 0 || !(d2[n - 1] > 0)) continue;
-            float* f = &cache.coefficients[c * size_t(count)];
-            bool centreScatters = false;
-            if (order > 0) {
-                evalMedia(ctx, regionAtRayStart(scene, Ray{x, Vec3(0, 0, 1)}), x, mp);
-                centreScatters = mp.scatters();
-                if (centreScatters) mp.phase.legendreWeights(order, w);
-            }
-            for (size_t i = 0; i + 1 < n; ++i) {  // the farthest only sets the radius
-                const Photon& p = map[idx[i]];
-                float weight = average(p.weight);
-                if (order == 0) {
-                    f[0] += weight;
-                    continue;
-                }
-                evalSh(order, p.travelDirection(), Y);
-                if (!centreScatters) hgLegendreWeights(order, p.g(), w);
-                for (int l = 0; l <= order; ++l)
-                    for (int m = -l; m <= l; ++m) f[shIndex(l, m)] += weight * w[l] * Y[shIndex(l, m)];
-            }
-            float r2 = d2[n - 1];
-            float invVolume = 1 / (4.f / 3.f * Pi * r2 * std::sqrt(r2));
-            // Order 0: Y_00 = 1 / sqrt(4 pi) and w'_0 = 1.
-            if (order == 0) f[0] *= 0.28209479f;
-            for (int i = 0; i < count; ++i) f[i] *= invVolume;
-        }
-    });
+    cache.incidentOrder = settings.incidentOrder;
+    cache.coefficients = estimateCoefficients(scene, map, cache, kNearest, cache.incident);
     cache.finalize();
     cache.info.buildSeconds = secondsSince(start);
     if (stats) {
@@ -273,6 +293,21 @@ RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_
         stats->cells = cache.cells.size();
     }
     return cache;
+}
+
+void refineRadianceCache(const Scene& scene, const PhotonMap& photons, size_t paths, int k, RadianceCache& cache) {
+    if (cache.cells.empty() || photons.size() == 0) return;
+    std::vector<float> freshIncident;
+    const std::vector<float> fresh = estimateCoefficients(scene, photons, cache, k, freshIncident);
+    // The running mean over equally weighted, independent batches.
+    const double n = double(std::max<uint32_t>(1, cache.info.batches));
+    const float keep = float(n / (n + 1)), add = float(1 / (n + 1));
+    for (size_t i = 0; i < fresh.size(); ++i) cache.coefficients[i] = keep * cache.coefficients[i] + add * fresh[i];
+    for (size_t i = 0; i < freshIncident.size(); ++i)
+        cache.incident[i] = keep * cache.incident[i] + add * freshIncident[i];
+    cache.info.batches = uint32_t(n) + 1;
+    cache.info.photons += photons.size();
+    cache.info.paths += paths;
 }
 
 }  // namespace vdbmarch

@@ -28,5 +28,11 @@ int effectiveShOrder(const Scene& scene, int requested);
 RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& photons, size_t paths,
                                  const CacheSettings& settings, int k, CacheBuildStats* stats = nullptr);
 
+// Progressive refinement: eq. 27 from a fresh, independent photon batch on
+// the cache's own cells, averaged with the info.batches estimates it holds
+// (each batch's weights carry 1 / its paths, so every estimate is of the same
+// L_i and the mean's variance falls as 1 / batches). The topology stays.
+void refineRadianceCache(const Scene& scene, const PhotonMap& photons, size_t paths, int k, RadianceCache& cache);
+
 
 }  // namespace vdbmarch

@@ -107,7 +107,7 @@ size_t RadianceCache::cellsAtLevel(int level) const {
 }
 
 size_t RadianceCache::memoryBytes() const {
-    size_t bytes = coefficients.size() * sizeof(float) + cells.size() * sizeof(CacheCell);
+    size_t bytes = (coefficients.size() + incident.size()) * sizeof(float) + cells.size() * sizeof(CacheCell);
     if (mIndex)
         for (const auto& t : mIndex->levels) bytes += t->memUsage();
     return bytes;
@@ -159,6 +159,7 @@ void RadianceCache::save(const std::string& path) const {
             g->insertMeta("phase_g", openvdb::FloatMetadata(info.meanG));
             g->insertMeta("photons", openvdb::Int64Metadata(int64_t(info.photons)));
             g->insertMeta("photon_paths", openvdb::Int64Metadata(int64_t(info.paths)));
+            g->insertMeta("photon_batches", openvdb::Int32Metadata(int32_t(info.batches)));
             g->insertMeta("seed", openvdb::Int64Metadata(int64_t(info.seed)));
             g->insertMeta("k", openvdb::Int32Metadata(info.k));
             g->insertMeta("quality", openvdb::FloatMetadata(info.quality));
@@ -267,6 +268,9 @@ RadianceCache RadianceCache::load(const std::string& path) {
     c.info.photons = uint64_t(metaValue<int64_t>(*first, "photons", path));
     c.info.paths = uint64_t(metaValue<int64_t>(*first, "photon_paths", path));
     c.info.seed = uint64_t(metaValue<int64_t>(*first, "seed", path));
+    // Caches baked before progressive refinement hold one batch.
+    if ((*first)["photon_batches"])
+        c.info.batches = uint32_t(std::max(1, metaValue<int32_t>(*first, "photon_batches", path)));
     c.info.k = metaValue<int32_t>(*first, "k", path);
     c.info.quality = metaValue<float>(*first, "quality", path);
     c.info.adaptive = metaValue<bool>(*first, "adaptive", path);

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "cache/sh.h"
 #include "core/math.h"
 #include "parse/scene_desc.h"
 
@@ -27,6 +28,7 @@ struct CacheInfo {
     bool adaptive = false;
     float minCell = 0;
     uint64_t photons = 0, paths = 0, seed = 0;
+    uint32_t batches = 1;    // independent photon batches averaged (refineRadianceCache)
     float meanG = 0;         // sigma_s-weighted mean g of the scattering media
     std::string sceneHash;
     std::string version;
@@ -56,6 +58,16 @@ public:
     int levels = 1;
     std::vector<CacheCell> cells;
     std::vector<float> coefficients;  // coefficientCount() per cell
+    // Optional (never saved): SH coefficients, up to band incidentOrder, of
+    // the incident radiance of the photons that are not direct, i.e. of the
+    // light a continuation path finds beside next-event estimation, over the
+    // light's travel direction (no phase convolution). Product sampling of
+    // continuation directions reads them. incidentOrder < 0: none.
+    int incidentOrder = -1;
+    std::vector<float> incident;
+    const float* cellIncident(size_t cell) const {
+        return &incident[cell * size_t(shCount(incidentOrder))];
+    }
 
     int coefficientCount() const { return (info.shOrder + 1) * (info.shOrder + 1); }
     float cellSize(int level) const { return baseCell / float(1 << level); }

@@ -1,9 +1,11 @@
 #include "illumination/illumination.h"
 
 #include <chrono>
+#include <cmath>
 
 #include "cache/cache_build.h"
 #include "core/error.h"
+#include "core/rng.h"
 #include "photons/photon_tracer.h"
 #include "transport/surface_event.h"
 
@@ -27,6 +29,36 @@ void checkCacheMatchesScene(const RadianceCache& cache, const Scene& scene, cons
     warn(msg + "; used anyway (--force)");
 }
 
+namespace {
+
+// The photons L_i takes beside shadow rays (see IlluminationRequest).
+bool wantedInMap(const Photon& p, const IlluminationRequest& rq) {
+    return rq.causticsOnly ? p.isCaustic() || (p.isFromPointLight() && !p.isDirect()) : !p.isDirect();
+}
+
+std::unique_ptr<PhotonMap> indirectMap(const std::vector<Photon>& photons, const IlluminationRequest& rq) {
+    size_t count = 0;
+    for (const Photon& p : photons) count += wantedInMap(p, rq);
+    if (count == 0) return nullptr;
+    std::vector<Photon> kept;
+    kept.reserve(count);
+    for (const Photon& p : photons)
+        if (wantedInMap(p, rq)) kept.push_back(p);
+    return std::make_unique<PhotonMap>(std::move(kept));
+}
+
+// Photon pass `pass`'s batch: pass 0 takes the photon seed itself (so a
+// single-pass render is what it always was), later passes independent
+// streams from it.
+uint64_t batchSeed(const IlluminationRequest& rq, int pass) {
+    const uint64_t seed = rq.photons.seedFor(rq.renderSeed);
+    return pass == 0 ? seed : hashValues(seed, 0x70617373ull, uint64_t(pass));
+}
+
+bool refinesCacheAt(int pass) { return pass > 0 && ((pass + 1) & pass) == 0; }  // passes 1, 3, 7, 15, ...
+
+}  // namespace
+
 Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq) {
     const auto start = Clock::now();
     Illumination il;
@@ -39,10 +71,11 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
         RadianceCache c = RadianceCache::load(rq.cacheFile);
         checkCacheMatchesScene(c, scene, rq.cacheFile, rq.force);
         il.cache = std::make_unique<RadianceCache>(std::move(c));
+        il.cacheLoaded = true;
         needCache = false;
     }
     if (needCache || rq.indirect || rq.keepAllPhotons) {
-        const uint64_t seed = rq.photons.seedFor(rq.renderSeed);
+        const uint64_t seed = batchSeed(rq, 0);
         PhotonSet set = tracePhotons(scene, size_t(rq.photons.count), seed);
         IlluminationStats& st = il.stats;
         st.traceSeconds = set.seconds;
@@ -50,18 +83,9 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
         st.photons = set.photons.size();
         st.directPhotons = set.directCount;
         const auto treeStart = Clock::now();
-        auto wanted = [&](const Photon& p) {
-            return rq.causticsOnly ? p.isCaustic() || (p.isFromPointLight() && !p.isDirect()) : !p.isDirect();
-        };
-        size_t count = 0;
-        for (const Photon& p : set.photons) count += wanted(p);
-        if (rq.indirect && count > 0) {
-            std::vector<Photon> indirect;
-            indirect.reserve(count);
-            for (const Photon& p : set.photons)
-                if (wanted(p)) indirect.push_back(p);
-            il.indirect = std::make_unique<PhotonMap>(std::move(indirect));
-            st.photonBytes += il.indirect->memoryBytes();
+        if (rq.indirect) {
+            il.indirect = indirectMap(set.photons, rq);
+            if (il.indirect) st.photonBytes += il.indirect->memoryBytes();
         }
         if (needCache || rq.keepAllPhotons) {
             // The cache approximates all of L_i (direct and scattered), as
@@ -88,6 +112,51 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
     return il;
 }
 
+double progressiveRadiusScale(int pass, double alpha) {
+    // r_j^3 / r_0^3 = prod_{i=1}^{j} (i + alpha) / (i + 1)
+    //             = Gamma(j + 1 + alpha) / (Gamma(1 + alpha) Gamma(j + 2)).
+    if (pass <= 0) return 1;
+    const double j = double(pass);
+    return std::exp((std::lgamma(j + 1 + alpha) - std::lgamma(1 + alpha) - std::lgamma(j + 2)) / 3);
+}
+
+PhotonPasses::PhotonPasses(const Scene& scene, const IlluminationRequest& rq, int pixels) : mRequest(rq) {
+    const bool buildsCache = rq.cache && rq.cacheFile.empty();
+    mProgressive = rq.photons.progressive && sceneScatters(scene) && rq.photons.count > 0 && (rq.indirect || buildsCache);
+    mSamplesPerPass = rq.photons.sppPerPass > 0
+                          ? rq.photons.sppPerPass
+                          : int(std::max<int64_t>(1, (rq.photons.count + 4 * int64_t(std::max(1, pixels)) - 1) /
+                                                             (4 * int64_t(std::max(1, pixels)))));
+}
+
+bool PhotonPasses::needsWork(int pass) const {
+    return mProgressive && pass > 0 && (mRequest.indirect || (refinesCacheAt(pass) && mRequest.cache));
+}
+
+void PhotonPasses::advance(const Scene& scene, int pass, Illumination& il) const {
+    if (pass == il.pass) return;
+    il.pass = pass;
+    il.radiusScale = float(progressiveRadiusScale(pass, mRequest.photons.alpha));
+    const bool refine = refinesCacheAt(pass) && il.cache && !il.cacheLoaded;
+    if (!mRequest.indirect && !refine) return;
+    const auto start = Clock::now();
+    PhotonSet set = tracePhotons(scene, size_t(mRequest.photons.count), batchSeed(mRequest, pass));
+    IlluminationStats& st = il.stats;
+    st.traceSeconds += set.seconds;
+    st.paths += set.paths;
+    st.photons += set.photons.size();
+    st.directPhotons += set.directCount;
+    ++st.batches;
+    if (mRequest.indirect) il.indirect = indirectMap(set.photons, mRequest);
+    if (refine) {
+        const auto estimateStart = Clock::now();
+        PhotonMap all(std::move(set.photons));
+        refineRadianceCache(scene, all, set.paths, mRequest.photons.k, *il.cache);
+        st.estimateSeconds += secondsSince(estimateStart);
+    }
+    st.seconds += secondsSince(start);
+}
+
 IlluminationRequest illuminationRequest(const Scene& scene, Method method, const IlluminationOptions& options) {
     const RenderSettings& rs = scene.desc.render;
     IlluminationRequest rq;
@@ -101,6 +170,9 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     }
     rq.cache = methodUsesCache(method, rs);
     if (rq.cache) rq.cacheFile = options.cacheFile;
+    // Product sampling of continuation directions reads the non-direct
+    // incident radiance (band 3), estimated beside eq. 27.
+    if (rq.cache && rs.li == LiSource::Path && rs.productSampling) rq.cacheSettings.incidentOrder = 3;
     else if (!options.cacheFile.empty())
         warn(str(options.cacheFile, ": method ", methodName(method), " with render.li = \"", liSourceName(rs.li),
                  "\" does not read the cache; ignored"));

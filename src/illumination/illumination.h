@@ -35,6 +35,7 @@ struct IlluminationStats {
     size_t paths = 0, photons = 0, directPhotons = 0;
     double traceSeconds = 0, treeSeconds = 0, topologySeconds = 0, estimateSeconds = 0;
     double seconds = 0;  // all of it
+    int batches = 1;     // photon batches traced (progressive passes)
     size_t photonBytes = 0, cacheBytes = 0;
 };
 
@@ -48,6 +49,11 @@ struct Illumination {
     int k = 50;                            // photons per estimate
     bool pointLightsByPhotons = false;     // "path": indirect carries point and spot lights' scattered light
     LiSource li = LiSource::Photons;
+    bool cacheLoaded = false;  // from a baked file: never refined
+    // Progressive photon pass the map belongs to, and its gather radius
+    // relative to the k-nearest sphere (PhotonPasses).
+    int pass = 0;
+    float radiusScale = 1;
     IlluminationStats stats;
 };
 
@@ -55,6 +61,38 @@ struct Illumination {
 // and the cache (or loads it, checked against the scene). Nothing is traced
 // when no medium scatters.
 Illumination buildIllumination(const Scene& scene, const IlluminationRequest& request);
+
+// Progressive photon mapping (Knaus & Zwicker 2011, "Progressive photon
+// mapping: a probabilistic approach"): camera samples [j B, (j + 1) B) use
+// photon pass j, B = samplesPerPass(). Each pass traces an independent batch
+// (its own seed), so the average over passes of the photon estimates is an
+// average of independent estimates; the gather radius of pass j is
+// progressiveRadiusScale(j) times the k-nearest radius, shrinking as
+// r_j^3 = r_{j-1}^3 (j + alpha) / (j + 1), so that bias and variance of the
+// average both go to zero (the variance of pass j grows as 1 / r_j^3, the
+// sum grows slower than passes^2). The radiance cache is refined, not
+// rebuilt, at passes 1, 3, 7, ...: the guide improves with time at a
+// logarithmic cost. The image depends only on the sample count.
+double progressiveRadiusScale(int pass, double alpha);
+
+class PhotonPasses {
+public:
+    PhotonPasses(const Scene& scene, const IlluminationRequest& request, int pixels);
+    bool progressive() const { return mProgressive; }
+    int samplesPerPass() const { return mSamplesPerPass; }
+    int passOf(int sample) const { return mProgressive ? sample / mSamplesPerPass : 0; }
+    int firstSampleOf(int pass) const { return pass * mSamplesPerPass; }
+    // True when moving to `pass` traces photons (a new map or a refinement).
+    bool needsWork(int pass) const;
+    // Brings `il` (built by buildIllumination from the same request) to
+    // `pass`: its radius, its own batch and map, and the cache refinement.
+    void advance(const Scene& scene, int pass, Illumination& il) const;
+
+private:
+    IlluminationRequest mRequest;
+    bool mProgressive = false;
+    int mSamplesPerPass = 1;
+};
 
 // What `method` and render.li need (nothing for the reference tracer).
 struct IlluminationOptions {

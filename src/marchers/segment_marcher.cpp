@@ -18,6 +18,9 @@ SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumin
     mLastEventByNextEvent = !hasBendingGlass(scene);
     for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
+    mProductSampling = scene.desc.render.productSampling && mIllumination->li == LiSource::Path &&
+                       mIllumination->cache && mIllumination->cache->incidentOrder >= 0 &&
+                       !mIllumination->cache->cells.empty();
 }
 
 PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
@@ -76,6 +79,21 @@ CacheLookup& SegmentMarcher::cacheLookup(ThreadContext& ctx) const {
     return *m.cacheLookup;
 }
 
+bool SegmentMarcher::buildProductSampler(ThreadContext& ctx, const Vec3& x, const Vec3& rayDir,
+                                         const MediumPoint& mp) const {
+    MarcherScratch& m = scratch(ctx);
+    const RadianceCache& cache = *mIllumination->cache;
+    if (!m.productQuery) m.productQuery = std::make_unique<RadianceCache::Query>(cache);
+    const int64_t cell = m.productQuery->find(x);
+    if (cell < 0) return false;
+    // The non-direct incident radiance there: what the path can find
+    // beside next-event estimation (the direct light of delta lights is not
+    // in it: a path never finds that).
+    const int order = std::min(cache.incidentOrder, ProductDirectionSampler::MaxOrder);
+    const float* incident = cache.cellIncident(size_t(cell));
+    return m.productSampler.build(order, incident, mp.phase, rayDir);
+}
+
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
                                   const MediumPoint& mp, Rng& rng, float pathProbability) const {
     if (!mp.scatters()) return Color(0);
@@ -88,10 +106,12 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         return Color(c.at(x));
     }
     const ScatterVertex vertex = ScatterVertex::inMedium(x, rayDir, mp.phase);
-    // Eq. 4 over the photons the L_i source keeps (none: no photon map).
+    // Eq. 4 over the photons the L_i source keeps (none: no photon map),
+    // gathered within this photon pass's radius.
     auto photons = [&] {
         if (!il.indirect) return Color(0);
-        return il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); });
+        return il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); }, nullptr,
+                                       il.radiusScale);
     };
     if (il.li == LiSource::Photons) return directLight(ctx, region, vertex, rng, {}) + photons();
     // A continuation path: next-event estimation here (weighed by MIS
@@ -107,13 +127,33 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         return directLight(ctx, region, vertex, rng, kLastEvent) + photons();
     }
     static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
-    Color Li = directLight(ctx, region, vertex, rng, kNextEvent);
+    // The continuation's direction: phase x cached radiance where the cache
+    // has a cell, else the phase. Next-event estimation weighs its sphere-
+    // light samples against that same density (MIS).
+    ScatterVertex nextEventVertex = vertex;
+    const ProductDirectionSampler* product = nullptr;
+    if (mProductSampling && buildProductSampler(ctx, x, rayDir, mp)) {
+        product = &scratch(ctx).productSampler;
+        nextEventVertex.pathSampler = product;
+        nextEventVertex.pathPdf = [](const void* s, const Vec3& wi) {
+            return static_cast<const ProductDirectionSampler*>(s)->pdf(wi);
+        };
+    }
+    Color Li = directLight(ctx, region, nextEventVertex, rng, kNextEvent);
     const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
     if (tracePathHere) {
         Color weight(1 / std::min(1.f, pathProbability));
         float pdf = 0;
-        const Vec3 wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
+        Vec3 wi;
+        if (product) {
+            const ProductSample s = product->sample(u0, u1, u2);
+            wi = s.wi;
+            weight *= s.weight;
+            pdf = s.pdf;
+        } else {
+            wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
+        }
         const PathState state{depth, false, pdf, x, il.pointLightsByPhotons};
         if (pdf > 0 && !mChromatic) {
             Li += weight * tracePath(ctx, Ray{x, wi}, region, -1, rng, state).L;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cache/cache_lookup.h"
+#include "cache/product_sampler.h"
 #include "illumination/illumination.h"
 #include "marchers/marcher.h"
 #include "marchers/ray_pdf.h"
@@ -25,6 +26,9 @@ struct MarcherScratch final : ThreadContextExtension {
     std::vector<float> stepH;
     RayPdf rayPdf;
     std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
+    // Continuation directions by phase x cached radiance (made on first use).
+    std::unique_ptr<RadianceCache::Query> productQuery;
+    ProductDirectionSampler productSampler;
     // The guided marcher's pre-pass (eq. 17's scale): march without sampling
     // and sum each segment's throughput times its histogram integral.
     bool measureOnly = false;
@@ -66,11 +70,15 @@ protected:
 
     static MarcherScratch& scratch(ThreadContext& ctx) { return ctx.extensionAs<MarcherScratch>(); }
     CacheLookup& cacheLookup(ThreadContext& ctx) const;
+    // Builds the scratch's product sampler for a continuation from x (false:
+    // no cell or no light there; sample the phase).
+    bool buildProductSampler(ThreadContext& ctx, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp) const;
 
     const Scene& mScene;
     std::shared_ptr<const Illumination> mIllumination;
     const bool mChromatic;  // continuation paths track one channel
     bool mLastEventByNextEvent = true;  // see the constructor
+    bool mProductSampling = false;      // render.product_sampling with a directional cache
 };
 
 // One step of length dx in a medium with extinction kappa: its transmittance,

@@ -75,6 +75,9 @@ struct RenderSettings {
     // How the marchers estimate L_i at their samples.
     LiSource li = LiSource::Path;
     int raySamples = 4;  // transmittance and guided: L_i samples per ray segment (mean for guided)
+    // li = "path" with a directional cache (guided): continuation directions
+    // from phase x cached radiance (cache/product_sampler.h), else the phase.
+    bool productSampling = false;  // measured slower to converge on cloud_sun and exp1_sphere (BENCHMARKS.md)
 };
 
 // The volume photon map (scene key "photons").
@@ -82,6 +85,13 @@ struct PhotonSettings {
     int64_t count = 100000;  // photon paths traced
     int k = 50;              // photons per radiance estimate (eq. 4)
     int64_t seed = -1;       // photon tracing's seed; -1: render.seed
+    // Progressive passes (Knaus & Zwicker 2011; docs/method.md): every
+    // sppPerPass camera samples trace a fresh batch of `count` paths and the
+    // gather radius shrinks by alpha's rule, so the photon part of L_i
+    // converges; the cache averages batches 1, 2, 4, 8, ...
+    bool progressive = true;
+    int sppPerPass = 0;      // 0: automatic, ceil(count / (4 pixels))
+    float alpha = 4.f / 7;   // radius rule r_{i+1}^3 = r_i^3 (i + alpha) / (i + 1); 4/7 balances bias and variance in 3D
     uint64_t seedFor(uint64_t renderSeed) const { return seed >= 0 ? uint64_t(seed) : renderSeed; }
 };
 
@@ -91,6 +101,9 @@ struct CacheSettings {
     float quality = 1;      // the paper's a
     bool adaptive = false;  // octree-like subdivision where photons are dense
     float minCell = 0;      // smallest adaptive cell, world units (0: automatic)
+    // Not a scene key: set by the renderer when product sampling reads the
+    // cache's non-direct incident radiance (RadianceCache::incident); -1: none.
+    int incidentOrder = -1;
 };
 
 struct SceneDesc {

@@ -260,7 +260,7 @@ SurfaceDesc parseSurface(const JsonReader& r) {
 
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
-                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples"});
+                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling"});
     RenderSettings s;
     {
         std::vector<std::string> names;
@@ -283,12 +283,13 @@ RenderSettings parseRender(const JsonReader& r) {
     s.exposure = float(r.numberIn("exposure", 0, -64, 64));
     s.globalMajorant = r.choice("majorant", "local", {"local", "global"}) == "global";
     parseLiSource(r.choice("li", liSourceName(s.li), {"path", "photons", "cache"}), s.li);
+    s.productSampling = r.boolean("product_sampling", s.productSampling);
     s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
     return s;
 }
 
 PhotonSettings parsePhotons(const JsonReader& r) {
-    r.allowOnly({"count", "k", "seed"});
+    r.allowOnly({"count", "k", "seed", "progressive", "spp_per_pass", "alpha"});
     PhotonSettings s;
     if (r.has("seed")) {
         const Json& v = r.raw("seed");
@@ -303,6 +304,15 @@ PhotonSettings parsePhotons(const JsonReader& r) {
         s.count = v.get<int64_t>();
     }
     s.k = r.integer("k", s.k, 1, 1024);
+    s.progressive = r.boolean("progressive", s.progressive);
+    s.sppPerPass = r.integer("spp_per_pass", s.sppPerPass, 0, 1 << 24);
+    // alpha = 1 keeps the radius (no convergence); 0 would shrink it as fast
+    // as the variance allows no averaging.
+    if (r.has("alpha")) {
+        double a = r.number("alpha");
+        if (!(a > 0 && a < 1)) r.fail("alpha", str("must be in (0, 1), got ", a));
+        s.alpha = float(a);
+    }
     return s;
 }
 

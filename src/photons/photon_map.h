@@ -32,10 +32,17 @@ public:
     // the k nearest photons, dV the sphere that holds them. The weights of
     // stored photons are Phi_p / sigma_t(x_p); wo is the direction the light
     // leaves in (towards the viewer), `phase(cos)` the phase function (a
-    // Color) with cos between a photon's travel direction and wo. `radius`,
-    // when given, receives the radius of the gathering sphere.
+    // Color) with cos between a photon's travel direction and wo.
+    // radiusScale < 1 (progressive passes, Knaus & Zwicker 2011) gathers only
+    // the photons within radiusScale times that sphere's radius, over its
+    // volume: given the k-th distance the k - 1 nearer photons are uniform in
+    // the sphere where the density is, so the expectation is the same and
+    // the kernel, hence the bias, is radiusScale times smaller (variance
+    // grows as radiusScale^-3). `radius`, when given, receives the radius of
+    // the gathering sphere.
     template <typename Phase>
-    Color estimateLi(const Vec3& x, const Vec3& wo, size_t k, Phase&& phase, float* radius = nullptr) const {
+    Color estimateLi(const Vec3& x, const Vec3& wo, size_t k, Phase&& phase, float* radius = nullptr,
+                     float radiusScale = 1) const {
         constexpr size_t MaxK = 1024;
         uint32_t idx[MaxK];
         float d2[MaxK];
@@ -44,12 +51,13 @@ public:
         // The farthest photon only sets the radius: summing the k - 1 inside
         // the sphere makes the estimate unbiased where photons are uniform
         // (docs/method.md).
+        const float r2 = d2[n - 1] * radiusScale * radiusScale;
         Color sum(0);
         for (size_t i = 0; i + 1 < n; ++i) {
+            if (radiusScale < 1 && d2[i] > r2) break;  // nearest first
             const Photon& p = mPhotons[idx[i]];
             sum += p.weight * phase(dot(p.travelDirection(), wo));
         }
-        float r2 = d2[n - 1];
         if (radius) *radius = std::sqrt(r2);
         if (!(r2 > 0)) return Color(0);
         return sum / (4.f / 3.f * Pi * r2 * std::sqrt(r2));

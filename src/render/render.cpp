@@ -72,14 +72,15 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
 
     // Photons and the cache count in the time budget: an equal-time
     // comparison charges the guided marcher for its cache.
+    const IlluminationRequest request = illuminationRequest(scene, rs.method, options.illumination);
+    const PhotonPasses photonPasses(scene, request, w * h);
     std::shared_ptr<Illumination> illumination;
     std::unique_ptr<Marcher> marcher;
     arena.execute([&] {
-        illumination = std::make_shared<Illumination>(prepareIllumination(scene, rs.method, options.illumination));
+        illumination = std::make_shared<Illumination>(buildIllumination(scene, request));
         marcher = makeMarcher(rs.method, scene, illumination);
     });
-    result.illuminationSeconds = illumination->stats.seconds;
-    result.photons = illumination->stats.photons;
+    const double firstIlluminationSeconds = illumination->stats.seconds;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
 
     // One pass renders samples [s0, s1) of every pixel. Each pixel sums its
@@ -120,28 +121,54 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         });
     };
 
+    // Samples [s0, s1), pass by pass of photons: the marcher is made again
+    // for each photon pass (its cache-derived scale changes with the cache).
+    auto renderSamples = [&](int s0, int s1) {
+        for (int s = s0; s < s1;) {
+            const int pass = photonPasses.passOf(s);
+            if (pass != illumination->pass) {
+                arena.execute([&] {
+                    photonPasses.advance(scene, pass, *illumination);
+                    marcher = makeMarcher(rs.method, scene, illumination);
+                });
+            }
+            const int end = std::min(s1, photonPasses.progressive() ? photonPasses.firstSampleOf(pass + 1) : s1);
+            renderPass(s, end);
+            s = end;
+        }
+    };
+
     int spp = 0;
     if (!timed) {
-        renderPass(0, rs.spp);
+        renderSamples(0, rs.spp);
         spp = rs.spp;
     } else {
         // Whole passes of one sample per pixel while the next one is expected
         // to finish within the budget (which also covers loading, measured
-        // from runStart); always at least one pass.
+        // from runStart); always at least one pass. A sample that starts a
+        // photon pass is expected to take as long as the first photons did.
         double lastPass = 0;
         do {
             auto p0 = std::chrono::steady_clock::now();
-            renderPass(spp, spp + 1);
+            const double photonsBefore = illumination->stats.seconds;
+            renderSamples(spp, spp + 1);
             ++spp;
             auto now = std::chrono::steady_clock::now();
-            lastPass = std::chrono::duration<double>(now - p0).count();
+            // The camera part of the sample (photons are predicted apart).
+            lastPass = std::chrono::duration<double>(now - p0).count() - (illumination->stats.seconds - photonsBefore);
             double elapsed = std::chrono::duration<double>(now - runStart).count();
             progress.set(elapsed / options.timeBudget);
-            if (elapsed + 1.05 * lastPass > options.timeBudget * 0.98) break;
+            const int next = photonPasses.passOf(spp);
+            const double nextPhotons =
+                next != illumination->pass && photonPasses.needsWork(next) ? firstIlluminationSeconds : 0.0;
+            if (elapsed + 1.05 * lastPass + nextPhotons > options.timeBudget * 0.98) break;
         } while (spp < (1 << 24));
         progress.set(1.0);
     }
     result.spp = spp;
+    result.illuminationSeconds = illumination->stats.seconds;
+    result.photons = illumination->stats.photons;
+    result.photonPasses = illumination->pass + 1;
     const float inv = 1.f / float(spp);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {

@@ -31,6 +31,7 @@ struct RenderResult {
     size_t photons = 0, cacheCells = 0;
     int threads = 0;      // worker threads used
     int spp = 0;          // samples per pixel actually rendered
+    int photonPasses = 1; // progressive photon passes used (illumination/illumination.h)
 };
 
 // Renders the scene with scene.desc.render's method, spp, seed and threads.

@@ -16,6 +16,7 @@ Color ScatterVertex::f(const Vec3& wi) const {
 }
 
 float ScatterVertex::pdf(const Vec3& wi) const {
+    if (pathPdf) return pathPdf(pathSampler, wi);
     if (phase) return phase->pdf(dot(wi, d));
     const Vec3 nf = dot(n, d) < 0 ? n : -n;
     return std::max(0.f, dot(wi, nf)) * InvPi;

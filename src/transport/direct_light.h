@@ -19,6 +19,10 @@ struct ScatterVertex {
     const PhaseMixture* phase = nullptr;
     Vec3 n;  // surface only
     Color albedo{0, 0, 0};
+    // The path's own direction density when it does not sample f (product
+    // sampling, a later layer): MIS must weigh light samples against it.
+    float (*pathPdf)(const void* sampler, const Vec3& wi) = nullptr;
+    const void* pathSampler = nullptr;
 
     static ScatterVertex inMedium(const Vec3& p, const Vec3& d, const PhaseMixture& phase) {
         return {p, d, &phase, Vec3(0), Color(0)};

@@ -112,15 +112,24 @@ INSTANTIATE_TEST_SUITE_P(Anisotropy, SingleScatteringSlab,
                          });
 
 // The same scene and seed give bit-identical pixels for any thread count,
-// for every method (photon tracing and the cache build included: max_depth 3).
-class Determinism : public ::testing::TestWithParam<Method> {};
+// for every method and L_i source (photon tracing and the cache build
+// included: max_depth 3), over several progressive photon passes (one per
+// sample: fresh photon maps, and the cache refined at passes 1 and 3).
+class Determinism : public ::testing::TestWithParam<std::tuple<Method, LiSource>> {};
+
+std::string liOverride(LiSource li) { return str("render.li=\"", liSourceName(li), "\""); }
+
+std::string methodLiName(const ::testing::TestParamInfo<std::tuple<Method, LiSource>>& info) {
+    return str(methodName(std::get<0>(info.param)), "_", liSourceName(std::get<1>(info.param)));
+}
 
 TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
+    const auto [method, li] = GetParam();
     std::string scenePath = samplePath("cloud.json");
     auto render = [&](int threads) {
-        SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[40,30]", "render.spp=2", "render.max_depth=3",
-                                                "photons.count=20000", methodOverride(GetParam()),
-                                                str("render.threads=", threads)});
+        SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[40,30]", "render.spp=4", "render.max_depth=3",
+                                                "photons.count=20000", "photons.spp_per_pass=1", liOverride(li),
+                                                methodOverride(method), str("render.threads=", threads)});
         return renderImage(*buildScene(d));
     };
     RenderResult a = render(1), b = render(2), c = render(5);
@@ -128,12 +137,19 @@ TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
     EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), b.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
     EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), c.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
     EXPECT_EQ(a.counters.marchSamples, c.counters.marchSamples);
+    // Photons are re-traced when a photon map or a cache is used (never by
+    // the reference tracer).
+    const bool photonsUsed = method != Method::Reference && (li == LiSource::Photons || method == Method::Guided);
+    EXPECT_EQ(a.photonPasses, photonsUsed ? 4 : 1);
     double sum = 0;
     for (float v : a.image.rgba) sum += v;
     EXPECT_GT(sum, 0);  // the cloud is lit: not a trivially black image
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, Determinism, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, Determinism,
+                         ::testing::Combine(::testing::ValuesIn(marcherMethods()),
+                                            ::testing::Values(LiSource::Path, LiSource::Photons)),
+                         methodLiName);
 
 // Work grows with active voxels, not with the bounding box: a far-away extra
 // voxel that inflates the bbox 50x leaves the march sample count unchanged.
@@ -157,11 +173,15 @@ TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
 // A time budget renders whole passes of one sample per pixel; the image is the
 // same, bit for bit, as a render of that many samples per pixel (for guided,
 // the cache lookups along a ray must not depend on earlier rays).
-class TimeBudget : public ::testing::TestWithParam<Method> {};
+class TimeBudget : public ::testing::TestWithParam<std::tuple<Method, LiSource>> {};
 
 TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
+    const auto [method, li] = GetParam();
     std::string scenePath = samplePath("cloud.json");
-    SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]", methodOverride(GetParam())});
+    // Photon passes every other sample: the image depends on the sample
+    // count only, not on where the budget ran out.
+    SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]", "render.max_depth=2", "photons.count=5000",
+                                            "photons.spp_per_pass=2", liOverride(li), methodOverride(method)});
     auto scene = buildScene(d);
     RenderOptions timed;
     timed.timeBudget = 0.5;
@@ -170,10 +190,14 @@ TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
     d.render.spp = a.spp;
     RenderResult b = renderImage(*buildScene(d));
     EXPECT_EQ(b.spp, a.spp);
+    EXPECT_EQ(b.photonPasses, a.photonPasses);
     EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), b.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget,
+                         ::testing::Combine(::testing::ValuesIn(marcherMethods()),
+                                            ::testing::Values(LiSource::Path, LiSource::Photons)),
+                         methodLiName);
 
 std::string furnaceScene(const std::string& sigmaS) {
     return R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_deg": 40, "resolution": [24, 24]},
