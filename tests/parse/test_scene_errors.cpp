@@ -127,6 +127,18 @@ TEST_F(BadInput, NegativeScalarSigmaAOnVdbMedium) {
     EXPECT_TRUE(hasNumberToken(msg, "-3")) << msg;
 }
 
+TEST_F(BadInput, ProgressivePhotonSettingsOutOfRange) {
+    std::string msg = errorOf<InputError>([&] { parseSceneText(R"({"photons": {"alpha": 1.5}})", "ppm.json"); });
+    EXPECT_CONTAINS(msg, "ppm.json");
+    EXPECT_CONTAINS(msg, "photons.alpha");
+    EXPECT_CONTAINS(msg, "1.5");
+    msg = errorOf<InputError>([&] { parseSceneText(R"({"photons": {"spp_per_pass": -2}})", "ppm.json"); });
+    EXPECT_CONTAINS(msg, "photons.spp_per_pass");
+    EXPECT_TRUE(hasNumberToken(msg, "-2")) << msg;
+    msg = errorOf<InputError>([&] { parseSceneText(R"({"photons": {"progressive": "yes"}})", "ppm.json"); });
+    EXPECT_CONTAINS(msg, "photons.progressive");
+}
+
 TEST_F(BadInput, HenyeyGreensteinGOfOne) {
     std::string msg = errorOf<InputError>([&] { parseSceneText(homogeneousScene(", \"g\": 1"), "g.json"); });
     EXPECT_CONTAINS(msg, "g.json");
