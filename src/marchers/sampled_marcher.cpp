@@ -110,9 +110,9 @@ private:
                 if (isBlack(mp.sigma_t)) continue;
                 const float len = float(b - a);
                 const StepTerms st = stepTerms(mp, len);
-                L += beta * T * st.absorbedA * mp.emission;
-                const float base = average(T * st.absorbedS);  // sigma_s T(t0) S(kappa, len)
-                if (mp.scatters() && base > 0) {
+                if (!isBlack(mp.emission)) L += beta * T * st.absorbedA * mp.emission;
+                const float base = mp.scatters() ? average(T * st.absorbedS) : 0.f;  // sigma_s T(t0) S(kappa, len)
+                if (base > 0) {
                     steps.push_back({float(a), len, average(mp.sigma_t), base});
                     m.stepSigmaS.push_back(mp.sigma_s);
                     m.stepKappa.push_back(mp.sigma_t);

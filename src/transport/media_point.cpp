@@ -9,9 +9,30 @@ ThreadContext::ThreadContext(const Scene& s) : scene(s) {
 }
 
 void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp) {
-    mp.sigma_a = mp.sigma_s = mp.sigma_t = mp.emission = Color(0);
+    const std::vector<int>& media = ctx.scene.regions[size_t(region)].media;
     mp.phase.clear();
-    for (int mi : ctx.scene.regions[size_t(region)].media) {
+    if (media.size() == 1) {  // the common case, once per march step: no sums
+        const int mi = media[0];
+        const float d = ctx.queries[size_t(mi)]->density(p);
+        if (!(d > 0)) {
+            mp.sigma_a = mp.sigma_s = mp.sigma_t = mp.emission = Color(0);
+            return;
+        }
+        const Medium& m = *ctx.scene.media[size_t(mi)];
+        mp.sigma_a = min(m.sigma_a * d, Color(MaxCoefficient));
+        mp.sigma_s = min(m.sigma_s * d, Color(MaxCoefficient));
+        mp.sigma_t = mp.sigma_a + mp.sigma_s;
+        mp.emission = Color(0);
+        if (m.hasEmission) {
+            const float e = ctx.queries[size_t(mi)]->emission(p);
+            if (e > 0)
+                for (int c = 0; c < 3; ++c) mp.emission[c] = mp.sigma_a[c] > 0 ? m.emissionColor[c] * e : 0.f;
+        }
+        mp.phase.add(mp.sigma_s, m.g);
+        return;
+    }
+    mp.sigma_a = mp.sigma_s = mp.sigma_t = mp.emission = Color(0);
+    for (int mi : media) {
         float d = ctx.queries[size_t(mi)]->density(p);
         if (!(d > 0)) continue;
         const Medium& m = *ctx.scene.media[size_t(mi)];

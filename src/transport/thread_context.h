@@ -21,7 +21,7 @@ struct ThreadContext {
     const Scene& scene;
     std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
     std::vector<Interval> intervals, shadowIntervals, scratch;
-    std::vector<MajorantSegment> majorants, scratchSegments;
+    std::vector<MajorantSegment> majorants;
     RenderCounters counters;
     std::unique_ptr<ThreadContextExtension> extension;
 

@@ -4,14 +4,22 @@
 
 namespace vdbmarch {
 
-void mediumMajorants(ThreadContext& ctx, int mi, const Ray& r, float tEnd, std::vector<MajorantSegment>& out) {
+void forEachMediumMajorant(ThreadContext& ctx, int mi, const Ray& r, float tEnd,
+                           const std::function<bool(const MajorantSegment&)>& visit) {
     const Medium& m = *ctx.scene.media[size_t(mi)];
     if (!ctx.scene.desc.render.globalMajorant || m.minVoxelSize() == 0) {
-        ctx.queries[size_t(mi)]->majorantSegments(r, 0.f, tEnd, out);
+        ctx.queries[size_t(mi)]->forEachMajorant(r, 0.f, tEnd, visit);
         return;
     }
     float t0 = 0, t1 = tEnd;
-    if (m.maxDensity() > 0 && m.worldBounds().intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1, m.maxDensity()});
+    if (m.maxDensity() > 0 && m.worldBounds().intersect(r, t0, t1) && t1 > t0) visit({t0, t1, m.maxDensity()});
+}
+
+void mediumMajorants(ThreadContext& ctx, int mi, const Ray& r, float tEnd, std::vector<MajorantSegment>& out) {
+    forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& s) {
+        out.push_back(s);
+        return true;
+    });
 }
 
 void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "core/rng.h"
@@ -30,6 +31,10 @@ inline float mediumMajorant(float maxDensity, float sigmaT) {
 // its bounding box (the classic baseline the local majorants are benchmarked
 // against).
 void mediumMajorants(ThreadContext& ctx, int medium, const Ray& r, float tEnd, std::vector<MajorantSegment>& out);
+// The same segments produced lazily, in increasing t, until visit returns
+// false (a shadow ray ended by roulette stops walking the grid's blocks).
+void forEachMediumMajorant(ThreadContext& ctx, int medium, const Ray& r, float tEnd,
+                           const std::function<bool(const MajorantSegment&)>& visit);
 
 // Combined extinction majorant of the region's media along [0, tEnd) for the
 // tracked `channel`.

@@ -64,21 +64,26 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
         }
         const float kMax = maxComponent(k);
         if (!(kMax > 0)) continue;
-        ctx.scratchSegments.clear();
-        mediumMajorants(ctx, mi, r, tEnd, ctx.scratchSegments);
-        for (const auto& seg : ctx.scratchSegments) {
+        // Block by block, lazily: a ray that roulette ends deep in a
+        // cloud never visits the blocks behind.
+        bool ended = false;
+        forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& seg) {
             const float sigmaMaj = mediumMajorant(seg.maxDensity, kMax);
-            if (!(sigmaMaj > 0)) continue;
+            if (!(sigmaMaj > 0)) return true;
             double t = seg.t0;
             while (true) {
                 t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
-                if (t >= seg.t1) break;
+                if (t >= seg.t1) return true;
                 ++ctx.counters.shadowSamples;
                 const float d = q.density(r.at(t));
                 for (int c = 0; c < 3; ++c) T[c] *= std::max(0.f, 1 - k[c] * d / sigmaMaj);
-                if (!russianRoulette(T, rng)) return Color(0);
+                if (!russianRoulette(T, rng)) {
+                    ended = true;
+                    return false;
+                }
             }
-        }
+        });
+        if (ended) return Color(0);
     }
     return T;
 }
