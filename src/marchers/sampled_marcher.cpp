@@ -93,44 +93,64 @@ private:
         if (cache) cache->setDirection(-ray.d);
 
         // The walk: steps [k dx, (k + 1) dx) clipped to the active
-        // intervals, the medium taken at one jittered point per step.
+        // intervals, the medium taken at one jittered point per step. The
+        // media of WalkBatch steps are looked up first, in a loop of
+        // independent lookups the core can overlap (a lookup's latency is
+        // about 2.4x its throughput), then the steps are taken in order.
+        // Roulette may end the walk inside a batch: the rest were looked up
+        // for nothing, never used (the pixels are those of a step-by-step
+        // walk).
         const double dx = double(scene.step);
         const double u = double(rng.uniform());
         Color T(1);  // from the segment's start
         bool ended = false;
-        MediumPoint mp;
+        MediumPoint* media = m.walkMedia;
+        double stepA[WalkBatch], stepB[WalkBatch];
+        Vec3 stepX[WalkBatch];
         for (const Interval& iv : ctx.intervals) {
-            for (double k = std::floor(double(iv.t0) / dx); !ended; k += 1) {
-                const double a = std::max(double(iv.t0), k * dx), b = std::min(double(iv.t1), (k + 1) * dx);
-                if (a >= double(iv.t1)) break;
-                if (!(b > a)) continue;
-                const Vec3 x = ray.at(float(a + u * (b - a)));
-                evalMedia(ctx, region, x, mp);
-                ++ctx.counters.marchSamples;
-                if (isBlack(mp.sigma_t)) continue;
-                const float len = float(b - a);
-                const StepTerms st = stepTerms(mp, len);
-                if (!isBlack(mp.emission)) L += beta * T * st.absorbedA * mp.emission;
-                const float base = mp.scatters() ? average(T * st.absorbedS) : 0.f;  // sigma_s T(t0) S(kappa, len)
-                if (base > 0) {
-                    steps.push_back({float(a), len, average(mp.sigma_t), base});
-                    m.stepSigmaS.push_back(mp.sigma_s);
-                    m.stepKappa.push_back(mp.sigma_t);
-                    m.stepT.push_back(T);
-                    if (cache) m.stepH.push_back(cache->at(x));
+            double k = std::floor(double(iv.t0) / dx);
+            while (!ended) {
+                int n = 0;
+                for (; n < WalkBatch; k += 1) {
+                    const double a = std::max(double(iv.t0), k * dx), b = std::min(double(iv.t1), (k + 1) * dx);
+                    if (a >= double(iv.t1)) break;
+                    if (!(b > a)) continue;
+                    stepA[n] = a;
+                    stepB[n] = b;
+                    stepX[n] = ray.at(float(a + u * (b - a)));
+                    ++n;
                 }
-                T *= st.T;
-                // Russian roulette on the rest of the segment; the steps
-                // already taken keep their weights, later ones carry 1/q.
-                const float q = rouletteSurvival(beta * T);
-                if (q < 1) {
-                    if (!(q > 0) || rng.uniform() >= q) {
-                        T = Color(0);
-                        ended = true;
-                    } else {
-                        T /= q;
+                for (int i = 0; i < n; ++i) evalMedia(ctx, region, stepX[i], media[i]);
+                for (int i = 0; i < n && !ended; ++i) {
+                    const MediumPoint& mp = media[i];
+                    const double a = stepA[i], b = stepB[i];
+                    ++ctx.counters.marchSamples;
+                    if (isBlack(mp.sigma_t)) continue;
+                    const float len = float(b - a);
+                    const StepTerms st = stepTerms(mp, len);
+                    if (!isBlack(mp.emission)) L += beta * T * st.absorbedA * mp.emission;
+                    const float base = mp.scatters() ? average(T * st.absorbedS) : 0.f;  // sigma_s T(t0) S(kappa, len)
+                    if (base > 0) {
+                        steps.push_back({float(a), len, average(mp.sigma_t), base});
+                        m.stepSigmaS.push_back(mp.sigma_s);
+                        m.stepKappa.push_back(mp.sigma_t);
+                        m.stepT.push_back(T);
+                        if (cache) m.stepH.push_back(cache->at(stepX[i]));
+                    }
+                    T *= st.T;
+                    // Russian roulette on the rest of the segment; the steps
+                    // already taken keep their weights, later ones carry 1/q.
+                    const float q = rouletteSurvival(beta * T);
+                    if (q < 1) {
+                        if (!(q > 0) || rng.uniform() >= q) {
+                            T = Color(0);
+                            ended = true;
+                        } else {
+                            T /= q;
+                        }
                     }
                 }
+                if (n < WalkBatch) break;  // the interval is done
             }
             if (ended) break;
         }

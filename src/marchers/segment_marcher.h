@@ -18,12 +18,16 @@
 
 namespace vdbmarch {
 
+// Steps whose media the sampled marchers' walk looks up together.
+constexpr int WalkBatch = 8;
+
 // Per-thread scratch of the marchers (ThreadContext::extension).
 struct MarcherScratch final : ThreadContextExtension {
     // The sampled marchers' per-ray histogram: steps, their media, the cache.
     std::vector<PdfStep> pdfSteps;
     std::vector<Color> stepSigmaS, stepKappa, stepT;
     std::vector<float> stepH;
+    MediumPoint walkMedia[WalkBatch];  // the media of the walk's next steps
     RayPdf rayPdf;
     std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
     // Continuation directions by phase x cached radiance (made on first use).
