@@ -1,5 +1,7 @@
 #include "app/command_line.h"
 
+#include "app/vdb_check.h"
+
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
@@ -44,7 +46,15 @@ std::vector<double> parseNumberList(const std::string& s, const std::string& opt
 }
 
 SceneDesc loadSceneInput(const std::string& input, const std::vector<std::string>& overrides) {
-    return endsWith(input, ".vdb") ? loadAutoScene(input, overrides) : loadSceneFile(input, overrides);
+    // Every VDB file is read once in a child process before this one opens
+    // it (app/vdb_check.h): a damaged file is an error, never a crash.
+    if (endsWith(input, ".vdb")) {
+        checkVdbFilesIsolated({input});
+        return loadAutoScene(input, overrides);
+    }
+    SceneDesc desc = loadSceneFile(input, overrides);
+    checkVdbFilesIsolated(vdbFilesOf(desc));
+    return desc;
 }
 
 }  // namespace vdbmarch

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace vdbmarch {
 
@@ -10,5 +11,16 @@ struct InfoArgs {
 };
 
 int runInfo(const InfoArgs& args);
+
+// `vdbmarch check FILE...`: reads every grid of each VDB file fully, in a
+// separate process (app/vdb_check.h), and says which are damaged or cut
+// short. --in-process reads in this process (what the separate one runs).
+struct CheckArgs {
+    std::vector<std::string> files;
+    bool inProcess = false;
+    bool quiet = false;
+};
+
+int runCheck(const CheckArgs& args);
 
 }  // namespace vdbmarch

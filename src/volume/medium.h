@@ -109,6 +109,10 @@ VdbGridSummary summarizeVdb(const std::string& file, const std::string& grid);
 // Names and types of every grid in a file ("density (float)", ...).
 std::vector<std::string> listVdbGrids(const std::string& file);
 
+// Reads every grid of the file fully (any value type); returns the active
+// voxels in all. Throws InputError naming the file and grid on failure.
+size_t readEveryGrid(const std::string& file);
+
 // openvdb::initialize(), once per process: the library calls it before it
 // reads or writes VDB files, and so does any code that uses OpenVDB directly.
 void initOpenVdb();

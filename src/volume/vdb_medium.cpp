@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/io/GridDescriptor.h>
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/tools/Morphology.h>
@@ -39,12 +40,64 @@ std::string gridTypeName(const openvdb::GridBase& g) {
     return t;
 }
 
-// Opens a VDB file, turning OpenVDB's exceptions into messages that name it.
+// Reads a VDB file's header and grid descriptors, as io::File::open does,
+// to check what OpenVDB's reader takes on trust: every grid's data must lie
+// inside the file (a file cut short, by a failed copy, ends before its last
+// grid's end position, and OpenVDB would read the front part silently).
+class GridExtentCheck : public openvdb::io::Archive {
+public:
+    void check(const std::string& path) {
+        std::ifstream is(path, std::ios::binary);
+        if (!is) throw IoError(str(path, ": cannot open VDB file: ", std::strerror(errno)));
+        is.seekg(0, std::ios::end);
+        const int64_t size = int64_t(is.tellg());
+        is.seekg(0, std::ios::beg);
+        readHeader(is);
+        if (!inputHasGridOffsets()) return;  // files before grid offsets: nothing to check against
+        setFormatVersion(is);
+        setLibraryVersion(is);
+        setDataCompression(is);
+        openvdb::MetaMap meta;
+        meta.readMeta(is);
+        const int32_t count = readGridCount(is);
+        if (count < 0) throw InputError(str(path, ": damaged VDB file (grid count ", count, ")"));
+        for (int32_t i = 0; i < count; ++i) {
+            if (!is.good() || int64_t(is.tellg()) >= size)
+                throw InputError(str(path, ": the VDB file is cut short: it ends (", size,
+                                     " bytes) before the descriptor of grid ", i + 1, " of ", count,
+                                     "; copy it again"));
+            openvdb::io::GridDescriptor gd;
+            gd.read(is);
+            const std::string name = openvdb::io::GridDescriptor::nameAsString(gd.uniqueName());
+            if (gd.getGridPos() < 0 || gd.getBlockPos() < gd.getGridPos() || gd.getEndPos() < gd.getBlockPos())
+                throw InputError(str(path, ": damaged VDB file: grid '", name, "' has inconsistent offsets (",
+                                     gd.getGridPos(), ", ", gd.getBlockPos(), ", ", gd.getEndPos(), ")"));
+            if (gd.getEndPos() > size)
+                throw InputError(str(path, ": the VDB file is cut short: grid '", name, "' ends at byte ",
+                                     gd.getEndPos(), " but the file has ", size, " bytes; copy it again"));
+            gd.seekToEnd(is);
+        }
+    }
+    // Archive's interface, unused: this class only reads descriptors.
+    openvdb::io::Archive::Ptr copy() const override { return std::make_shared<GridExtentCheck>(*this); }
+};
+
+// Opens a VDB file, turning OpenVDB's exceptions into messages that name it,
+// and refuses a file whose grids do not lie inside it (GridExtentCheck).
 std::unique_ptr<openvdb::io::File> openVdbFile(const std::string& path) {
     initOpenVdb();
     {
         std::ifstream probe(path, std::ios::binary);
         if (!probe) throw IoError(str(path, ": cannot open VDB file: ", std::strerror(errno)));
+    }
+    try {
+        GridExtentCheck().check(path);
+    } catch (const InputError&) {
+        throw;
+    } catch (const IoError&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw InputError(str(path, ": not a readable OpenVDB file (", e.what(), ")"));
     }
     auto file = std::make_unique<openvdb::io::File>(path);
     try {
@@ -664,6 +717,21 @@ std::vector<std::string> listVdbGrids(const std::string& path) {
     auto grids = file->readAllGridMetadata();
     for (const auto& g : *grids) out.push_back(str(g->getName(), " (", gridTypeName(*g), ")"));
     return out;
+}
+
+size_t readEveryGrid(const std::string& path) {
+    auto file = openVdbFile(path);
+    size_t voxels = 0;
+    for (auto name = file->beginName(); name != file->endName(); ++name) {
+        openvdb::GridBase::Ptr g;
+        try {
+            g = file->readGrid(*name);
+        } catch (const std::exception& e) {
+            throw InputError(str(path, ": grid '", *name, "' could not be read (", e.what(), ")"));
+        }
+        voxels += size_t(g->activeVoxelCount());
+    }
+    return voxels;
 }
 
 }  // namespace vdbmarch

@@ -72,6 +72,55 @@ TEST_F(BadInput, TruncatedVdbCli) {
     EXPECT_FALSE(fs::exists(work("out.exr")));
 }
 
+// Cut anywhere past its header, a VDB file is refused by the grid extent
+// check, never read in part: the message names the file and says it is cut
+// short. At any cut, `info` and `check` exit 1 naming it.
+TEST_F(BadInput, VdbCutAnywhereIsRefusedNotReadInPartCli) {
+    const std::string bytes = readBytes(work("grids.vdb"));
+    ASSERT_GT(bytes.size(), 1000u);
+    for (double f : {0.05, 0.5, 0.9, 0.97, 0.99, 0.999}) {
+        const size_t len = std::max<size_t>(1, size_t(double(bytes.size()) * f));
+        for (size_t cut : {len, bytes.size() - 1}) {
+            writeText(work("cut.vdb"), bytes.substr(0, cut));
+            CliResult r = cli({"info", "cut.vdb"});
+            expectCliError(r, {"cut.vdb"});
+            if (cut > bytes.size() / 2) EXPECT_NE(r.err.find("cut short"), std::string::npos) << cut << ": " << r.err;
+            r = cli({"check", "cut.vdb"});
+            expectCliError(r, {"cut.vdb"});
+        }
+    }
+    // The whole file reads cleanly.
+    CliResult ok = cli({"check", "grids.vdb"});
+    EXPECT_EQ(ok.exitCode, 0) << ok.err;
+}
+
+// Regression fixtures from the damaged-file catalogue (tools/
+// damage_catalogue.py), made from the project's own sample: one changed byte
+// in vdb_samples/cloud.vdb makes OpenVDB's reader corrupt the heap and abort
+// ("free(): invalid pointer") when it reads the grid in-process. Every command
+// that opens it must instead exit 1 naming the file: the file is read in a
+// child process first (app/vdb_check.h).
+TEST_F(BadInput, VdbThatCrashesOpenVdbsReaderIsAnErrorCli) {
+    std::string bytes = readBytes(samplePath("cloud.vdb"));
+    ASSERT_EQ(bytes.size(), 689538u) << "vdb_samples/cloud.vdb changed: find new crashers with tools/damage_catalogue.py";
+    for (auto [offset, value] : {std::pair<size_t, int>{111263, 29}, {111444, 221}, {114343, 114}}) {
+        std::string damaged = bytes;
+        damaged[offset] = char(value);
+        writeText(work("damaged.vdb"), damaged);
+        CliResult r = cli({"info", "damaged.vdb"});
+        expectCliError(r, {"damaged.vdb"});
+        r = cli({"check", "damaged.vdb"});
+        expectCliError(r, {"damaged.vdb"});
+        r = cli({"render", "damaged.vdb", "-o", "out.exr", "--res", "16x12", "--spp", "1"});
+        expectCliError(r, {"damaged.vdb"});
+        EXPECT_FALSE(fs::exists(work("out.exr")));
+        scene("scene.json", vdbScene("density", "damaged.vdb"));
+        r = cli({"render", "scene.json", "-o", "out.exr"});
+        expectCliError(r, {"damaged.vdb"});
+        EXPECT_FALSE(fs::exists(work("out.exr")));
+    }
+}
+
 // ===========================================================================
 // 3. A grid name that does not exist
 

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# AddressSanitizer + UndefinedBehaviorSanitizer build of the project, then
+# the unit and stress suites under it (issue 12). Zero findings expected:
+# any report makes its test fail (halt_on_error) and this script exit 1.
+# Usage: tools/sanitize.sh [LABELS]   (ctest label regex, default "unit|stress")
+# Environment: BUILD (default build-asan), JOBS (default: all cores).
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="${BUILD:-$ROOT/build-asan}"
+LABELS="${1:-unit|stress}"
+JOBS="${JOBS:-$(nproc)}"
+LAUNCHER=""
+command -v ccache >/dev/null && LAUNCHER="-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"
+FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo $LAUNCHER \
+    -DCMAKE_CXX_FLAGS="$FLAGS" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+cmake --build "$BUILD" -j "$JOBS"
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:strict_string_checks=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export LSAN_OPTIONS="suppressions=$ROOT/tools/lsan.supp"
+# The CLI tests run the sanitized vdbmarch too (VDBMARCH_BINARY points into $BUILD).
+ctest --test-dir "$BUILD" -L "$LABELS" -j "$JOBS" --output-on-failure
