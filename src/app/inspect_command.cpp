@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "app/command_line.h"
+#include "app/vdb_check.h"
 #include "cache/cache_inspect.h"
 #include "core/atomic_file.h"
 
@@ -23,6 +24,7 @@ Vec3 parseDirection(const std::string& text) {
 }  // namespace
 
 int runInspect(const InspectArgs& a) {
+    checkVdbFilesIsolated({a.input});
     RadianceCache c = RadianceCache::load(a.input);
     if (a.slice.empty() && a.direction.empty()) {
         if (!a.output.empty()) throw InputError("-o needs --direction (a .vdb of L_i) or --slice (a .png)");

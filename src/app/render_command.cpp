@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/vdb_check.h"
 #include "core/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/png_io.h"
@@ -105,6 +106,7 @@ int runRender(const RenderArgs& a) {
         throw InputError(str("--cache ", a.cache, ": the cache must be a .vdb file written by vdbmarch bake"));
     if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
 
+    if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
     SceneDesc desc = loadSceneInput(a.input, overrides);
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# libFuzzer runs of the readers (issue 12): the scene parser and --set
+# overrides, the OBJ/PLY mesh readers, and EXR images. The tree is built
+# with clang and -fsanitize=fuzzer-no-link,address,undefined in build-fuzz;
+# each harness starts from a seed corpus of the project's own files.
+# Usage: tools/fuzz.sh [RUNS]    executions per harness (default 1000000;
+#        CI uses a short run). Findings are written to build-fuzz/findings/
+#        and make the script exit 1.
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="${BUILD:-$ROOT/build-fuzz}"
+RUNS="${1:-1000000}"
+JOBS="${JOBS:-$(nproc)}"
+command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ is needed (apt-get install clang)"; exit 1; }
+LAUNCHER=""
+command -v ccache >/dev/null && LAUNCHER="-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"
+cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ $LAUNCHER \
+    -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" \
+    -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+    -DVDBMARCH_FUZZ=ON -DVDBMARCH_BUILD_TESTS=OFF -DVDBMARCH_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build "$BUILD" -j "$JOBS" --target fuzz_scene_json fuzz_mesh fuzz_exr
+
+# Seed corpora: the project's scenes, meshes and an image of its own.
+C="$BUILD/corpus"
+rm -rf "$C"; mkdir -p "$C/scene_json" "$C/mesh" "$C/exr" "$BUILD/findings"
+cp "$ROOT"/vdb_samples/*.json "$ROOT"/vdb_samples/scenes/*.json "$C/scene_json/"
+printf '{"render": {"spp": 2}}\n#set render.max_depth=3' > "$C/scene_json/with_set.json"
+{ printf '\0'; cat "$ROOT/vdb_samples/scenes/knot.obj"; } > "$C/mesh/knot.obj"
+{ printf '\1'; printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n'; } > "$C/mesh/tri_ascii.ply"
+python3 - "$C/mesh/tri_binary.ply" <<'PY'
+import struct, sys
+h = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+body = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<B3i", 3, 0, 1, 2)
+open(sys.argv[1], "wb").write(b"\x01" + h + body)
+PY
+if [ -x "$ROOT/build/bin/vdbmarch" ]; then
+  "$ROOT/build/bin/vdbmarch" render "$ROOT/vdb_samples/sparse.json" -o "$C/exr/small.exr" --res 8x6 --spp 1 -q
+fi
+
+status=0
+for h in scene_json mesh exr; do
+  echo "== fuzz_$h: $RUNS runs"
+  mkdir -p "$BUILD/findings/$h"
+  if ! ASAN_OPTIONS="detect_leaks=1" "$BUILD/fuzz_$h" "$C/$h" -runs="$RUNS" -max_len=65536 -timeout=10 \
+        -rss_limit_mb=2048 -artifact_prefix="$BUILD/findings/$h/" -print_final_stats=1 2>&1 | \
+        tee "$BUILD/findings/$h.log" | grep -E "^#[0-9]+ +(DONE|INITED)|stat::number_of_executed_units|ERROR|SUMMARY|crash-|timeout-|leak-|oom-"; then
+    :
+  fi
+  if ls "$BUILD/findings/$h/" 2>/dev/null | grep -q .; then
+    echo "fuzz_$h: findings in $BUILD/findings/$h/"; status=1
+  fi
+done
+exit $status
