@@ -41,13 +41,14 @@ status=0
 for h in scene_json mesh exr; do
   echo "== fuzz_$h: $RUNS runs"
   mkdir -p "$BUILD/findings/$h"
-  if ! ASAN_OPTIONS="detect_leaks=1" "$BUILD/fuzz_$h" "$C/$h" -runs="$RUNS" -max_len=65536 -timeout=10 \
-        -rss_limit_mb=2048 -artifact_prefix="$BUILD/findings/$h/" -print_final_stats=1 2>&1 | \
-        tee "$BUILD/findings/$h.log" | grep -E "^#[0-9]+ +(DONE|INITED)|stat::number_of_executed_units|ERROR|SUMMARY|crash-|timeout-|leak-|oom-"; then
-    :
-  fi
-  if ls "$BUILD/findings/$h/" 2>/dev/null | grep -q .; then
-    echo "fuzz_$h: findings in $BUILD/findings/$h/"; status=1
+  rc=0
+  ASAN_OPTIONS="detect_leaks=1" "$BUILD/bin/fuzz_$h" "$C/$h" -runs="$RUNS" -max_len=65536 -timeout=10 \
+      -rss_limit_mb=2048 -artifact_prefix="$BUILD/findings/$h/" -print_final_stats=1 \
+      > "$BUILD/findings/$h.log" 2>&1 || rc=$?
+  grep -E "^#[0-9]+ +(DONE|INITED)|stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|SUMMARY" \
+      "$BUILD/findings/$h.log" || true
+  if [ $rc -ne 0 ] || ls "$BUILD/findings/$h/" 2>/dev/null | grep -q .; then
+    echo "fuzz_$h: exit $rc, findings in $BUILD/findings/$h/ (log: $BUILD/findings/$h.log)"; status=1
   fi
 done
 exit $status

@@ -458,6 +458,12 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
         if (colon != std::string::npos) detail = detail.substr(colon + 2);
         throw InputError(str(file, ":", line, ":", col, ": malformed JSON: ", detail, "\n    ", excerpt, "\n    ",
                              std::string(col > 0 ? col - 1 : 0, ' '), "^"));
+    } catch (const Json::exception& e) {
+        // Not a syntax error, and without a position: a number too large for
+        // a double (found by fuzzing: "1E400" is out_of_range, not parse_error).
+        std::string what = e.what();
+        size_t close = what.find("] ");
+        throw InputError(str(file, ": malformed JSON: ", close == std::string::npos ? what : what.substr(close + 2)));
     }
     for (const auto& o : overrides) applyOverride(doc, o);
     try {

@@ -127,6 +127,17 @@ TEST_F(BadInput, NegativeScalarSigmaAOnVdbMedium) {
     EXPECT_TRUE(hasNumberToken(msg, "-3")) << msg;
 }
 
+// Found by fuzzing (tools/fuzz.sh, fuzz_scene_json): a number too large for
+// a double is nlohmann's out_of_range, not a parse_error, and escaped the
+// parser without the file's name.
+TEST_F(BadInput, NumberTooLargeForADoubleNamesTheFile) {
+    for (const char* text : {"111111111111111E11000000002060149047", R"({"render": {"spp": 1e400}})"}) {
+        std::string msg = errorOf<InputError>([&] { parseSceneText(text, "huge.json"); });
+        EXPECT_CONTAINS(msg, "huge.json");
+        EXPECT_CONTAINS(msg, "malformed JSON");
+    }
+}
+
 TEST_F(BadInput, ProgressivePhotonSettingsOutOfRange) {
     std::string msg = errorOf<InputError>([&] { parseSceneText(R"({"photons": {"alpha": 1.5}})", "ppm.json"); });
     EXPECT_CONTAINS(msg, "ppm.json");
