@@ -15,7 +15,10 @@ command -v ccache >/dev/null && LAUNCHER="-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"
 # reports must stop the test, not scroll by.
 cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo $LAUNCHER -DVDBMARCH_SANITIZE=ON \
     -DVDBMARCH_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_FLAGS="-fno-sanitize-recover=undefined" >/dev/null
-cmake --build "$BUILD" -j "$JOBS" --target vdbmarch vdbmarch_unit_tests vdbmarch_stress_tests
+TARGETS="vdbmarch vdbmarch_unit_tests"
+case "$LABELS" in *stress*) TARGETS="$TARGETS vdbmarch_stress_tests" ;; esac
+case "$LABELS" in *accuracy*) TARGETS="$TARGETS vdbmarch_accuracy_tests" ;; esac
+cmake --build "$BUILD" -j "$JOBS" --target $TARGETS
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:strict_string_checks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 export LSAN_OPTIONS="suppressions=$ROOT/tools/lsan.supp"
