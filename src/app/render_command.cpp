@@ -108,6 +108,7 @@ int runRender(const RenderArgs& a) {
 
     if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
     SceneDesc desc = loadSceneInput(a.input, overrides);
+    checkImageMemory(desc.camera.width, desc.camera.height);  // before any volume is loaded
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 

@@ -9,6 +9,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "core/error.h"
+#include "core/memory.h"
 #include "core/threads.h"
 #include "marchers/marcher.h"
 
@@ -52,9 +54,16 @@ private:
 
 }  // namespace
 
+void checkImageMemory(int width, int height) {
+    const uint64_t perPixel = sizeof(Color) + sizeof(double) + 4 * sizeof(float);
+    checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
+                str("camera.resolution = [", width, ", ", height, "]: the image"));
+}
+
 RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const RenderSettings& rs = scene.desc.render;
     const int w = scene.camera->width(), h = scene.camera->height();
+    checkImageMemory(w, h);
     const int tilesX = (w + TileSize - 1) / TileSize, tilesY = (h + TileSize - 1) / TileSize;
     const int tiles = tilesX * tilesY;
     const bool timed = options.timeBudget > 0;

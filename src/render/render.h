@@ -34,6 +34,11 @@ struct RenderResult {
     int photonPasses = 1; // progressive photon passes used (illumination/illumination.h)
 };
 
+// Refuses (InputError naming camera.resolution) an image whose buffers do
+// not fit in this machine's memory: per pixel the RGB sum, the transmittance
+// sum and the RGBA result.
+void checkImageMemory(int width, int height);
+
 // Renders the scene with scene.desc.render's method, spp, seed and threads.
 // Deterministic: each pixel sample has its own random stream, so the image is
 // bit-identical for any thread count.

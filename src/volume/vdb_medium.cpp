@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
+#include "core/memory.h"
 #include "core/transform.h"
 #include "volume/medium.h"
 #include "volume/vdb_io.h"
@@ -650,6 +651,17 @@ openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string
     }
     if (!file->hasGrid(name))
         throw InputError(str(path, ": no grid named '", name, "'; grids in the file: ", gridListing(*file)));
+    // The grid, its dilated topology and the padded blocks the walk reads:
+    // about three times the grid's own size, refused before reading it.
+    try {
+        const auto meta = file->readGridMetadata(name);
+        if (const auto bytes = meta->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_MEM_BYTES))
+            checkMemory(3 * uint64_t(std::max<int64_t>(0, bytes->value())),
+                        str(path, ": grid '", name, "' (", formatBytes(uint64_t(bytes->value())), " in memory)"));
+    } catch (const InputError&) {
+        throw;
+    } catch (const std::exception&) {  // no metadata: nothing to check before reading
+    }
     openvdb::GridBase::Ptr base;
     try {
         base = file->readGrid(name);

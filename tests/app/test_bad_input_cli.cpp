@@ -19,6 +19,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "image/exr_io.h"
 #include "scene/auto_scene.h"
 #include "support/support.h"
@@ -84,7 +85,9 @@ TEST_F(BadInput, VdbCutAnywhereIsRefusedNotReadInPartCli) {
             writeText(work("cut.vdb"), bytes.substr(0, cut));
             CliResult r = cli({"info", "cut.vdb"});
             expectCliError(r, {"cut.vdb"});
-            if (cut > bytes.size() / 2) EXPECT_NE(r.err.find("cut short"), std::string::npos) << cut << ": " << r.err;
+            if (cut > bytes.size() / 2) {
+                EXPECT_NE(r.err.find("cut short"), std::string::npos) << cut << ": " << r.err;
+            }
             r = cli({"check", "cut.vdb"});
             expectCliError(r, {"cut.vdb"});
         }
@@ -177,6 +180,18 @@ TEST_F(BadInput, HugeResolutionFromResOptionCli) {
     CliResult r = cli({"render", "scene.json", "-o", "out.exr", "--res", "100000x100000"});
     expectCliError(r, {"camera.resolution", "100000"});
     EXPECT_LT(r.seconds, 10) << "refused before any allocation or rendering";
+    EXPECT_FALSE(fs::exists(work("out.exr")));
+}
+
+// A photon count the machine cannot hold is refused before tracing, with
+// what it would need (2^32 paths: about 176 GiB).
+TEST_F(BadInput, PhotonCountBeyondMemoryIsRefusedCli) {
+    if (availableMemoryBytes() > (uint64_t(1) << 32) * 44) GTEST_SKIP() << "this machine could hold them";
+    scene("scene.json", homogeneousScene());
+    CliResult r = cli({"render", "scene.json", "-o", "out.exr", "--method", "guided", "--set",
+                       "photons.count=4294967296"});
+    expectCliError(r, {"photons.count", "GiB"});
+    EXPECT_LT(r.seconds, 10) << "refused before tracing";
     EXPECT_FALSE(fs::exists(work("out.exr")));
 }
 
