@@ -1,7 +1,8 @@
 #include "image/exr_io.h"
 
-#include "core/error.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/memory.h"
 
 #include <OpenEXR/Iex.h>
 #include <OpenEXR/ImfChannelList.h>
@@ -12,10 +13,12 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfTestFile.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <new>
 #include <cstdint>
 #include <utility>
@@ -23,6 +26,12 @@
 namespace vdbmarch {
 
 namespace {
+
+int channelCount(Imf::InputFile& in) {
+    int n = 0;
+    for (auto it = in.header().channels().begin(); it != in.header().channels().end(); ++it) ++n;
+    return n;
+}
 
 const char* const RgbaNames[4] = {"R", "G", "B", "A"};
 
@@ -99,6 +108,19 @@ Image readExr(const std::string& path) {
         const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
         if (w <= 0 || h <= 0 || w > (1 << 30) / h)
             throw InputError(str("'", path, "' has an unsupported data window of ", w, "x", h));
+        // A damaged header can claim any data window (fuzzing: 11 GB asked
+        // of a 1 kB file). Deflate shrinks at most ~1032:1 and every chunk
+        // costs bytes of its own, so a window whose samples (at least 2
+        // bytes each, as halfs) need over 2^20 times the file's size cannot
+        // be in the file, whatever its compression (a wide margin: a
+        // constant 16k x 16k RGBA image still passes).
+        std::error_code ec;
+        const uint64_t fileBytes = uint64_t(std::filesystem::file_size(path, ec));
+        const uint64_t minSampleBytes = uint64_t(w) * uint64_t(h) * 2 * uint64_t(std::max(1, channelCount(in)));
+        if (!ec && (minSampleBytes >> 20) > fileBytes)
+            throw InputError(str("'", path, "' claims a ", w, "x", h, " data window that a file of ", fileBytes,
+                                 " bytes cannot hold (damaged header?)"));
+        checkMemory(uint64_t(w) * uint64_t(h) * 4 * sizeof(float), str("'", path, "' (", w, "x", h, " pixels)"));
         const Imf::ChannelList& channels = in.header().channels();
         for (int c = 0; c < 3; ++c)
             if (!channels.findChannel(RgbaNames[c]))

@@ -110,6 +110,23 @@ TEST_F(ImageIoTest, ReadExrOfTruncatedFileThrowsInputError) {
     EXPECT_CONTAINS(errorOf<InputError>([&] { readExr(path("cut.exr")); }), path("cut.exr"));
 }
 
+// Found by fuzzing (tools/fuzz.sh, fuzz_exr): a damaged header claiming a
+// 2686984 x 257 data window made a 1 kB file allocate 11 GB before OpenEXR
+// noticed the data was missing. Now refused from the header, naming the file.
+TEST_F(ImageIoTest, ReadExrRefusesADataWindowTheFileCannotHold) {
+    writeExr(path("a.exr"), makeTestImage(8, 8), {});
+    std::string bytes = readBytes(path("a.exr"));
+    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+    const size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const int32_t box[4] = {0, 0, 2686983, 256};  // xmin, ymin, xmax, ymax after the 4-byte size
+    std::memcpy(&bytes[at + key.size() + 4], box, sizeof box);
+    writeText(path("huge.exr"), bytes);
+    const std::string msg = errorOf<InputError>([&] { readExr(path("huge.exr")); });
+    EXPECT_CONTAINS(msg, path("huge.exr"));
+    EXPECT_CONTAINS(msg, "2686984x257");
+}
+
 TEST_F(ImageIoTest, ExrRejectsReservedAttributeWithoutTouchingExistingFile) {
     writeText(path("keep.exr"), "old contents");
     EXPECT_THROW(writeExr(path("keep.exr"), makeTestImage(2, 2), {{"compression", "none"}}), InputError);
