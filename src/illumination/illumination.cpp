@@ -133,12 +133,12 @@ bool PhotonPasses::needsWork(int pass) const {
     return mProgressive && pass > 0 && (mRequest.indirect || (refinesCacheAt(pass) && mRequest.cache));
 }
 
-void PhotonPasses::advance(const Scene& scene, int pass, Illumination& il) const {
-    if (pass == il.pass) return;
+bool PhotonPasses::advance(const Scene& scene, int pass, Illumination& il) const {
+    if (pass == il.pass) return false;
     il.pass = pass;
     il.radiusScale = float(progressiveRadiusScale(pass, mRequest.photons.alpha));
     const bool refine = refinesCacheAt(pass) && il.cache && !il.cacheLoaded;
-    if (!mRequest.indirect && !refine) return;
+    if (!mRequest.indirect && !refine) return false;
     const auto start = Clock::now();
     PhotonSet set = tracePhotons(scene, size_t(mRequest.photons.count), batchSeed(mRequest, pass));
     IlluminationStats& st = il.stats;
@@ -155,6 +155,7 @@ void PhotonPasses::advance(const Scene& scene, int pass, Illumination& il) const
         st.estimateSeconds += secondsSince(estimateStart);
     }
     st.seconds += secondsSince(start);
+    return refine;
 }
 
 IlluminationRequest illuminationRequest(const Scene& scene, Method method, const IlluminationOptions& options) {

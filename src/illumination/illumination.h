@@ -86,7 +86,9 @@ public:
     bool needsWork(int pass) const;
     // Brings `il` (built by buildIllumination from the same request) to
     // `pass`: its radius, its own batch and map, and the cache refinement.
-    void advance(const Scene& scene, int pass, Illumination& il) const;
+    // Returns true when the cache changed (what a guided marcher measured
+    // from it must be measured again); the map and radius are read live.
+    bool advance(const Scene& scene, int pass, Illumination& il) const;
 
 private:
     IlluminationRequest mRequest;

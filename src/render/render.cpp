@@ -130,15 +130,16 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         });
     };
 
-    // Samples [s0, s1), pass by pass of photons: the marcher is made again
-    // for each photon pass (its cache-derived scale changes with the cache).
+    // Samples [s0, s1), pass by pass of photons: the marcher reads the pass's
+    // map and radius through `illumination`, and is made again only when the
+    // cache was refined (eq. 17's scale is measured from the cache).
     auto renderSamples = [&](int s0, int s1) {
         for (int s = s0; s < s1;) {
             const int pass = photonPasses.passOf(s);
             if (pass != illumination->pass) {
                 arena.execute([&] {
-                    photonPasses.advance(scene, pass, *illumination);
-                    marcher = makeMarcher(rs.method, scene, illumination);
+                    if (photonPasses.advance(scene, pass, *illumination))
+                        marcher = makeMarcher(rs.method, scene, illumination);
                 });
             }
             const int end = std::min(s1, photonPasses.progressive() ? photonPasses.firstSampleOf(pass + 1) : s1);
