@@ -42,27 +42,35 @@ if [ -x "$ROOT/build/bin/vdbmarch" ]; then
   "$ROOT/build/bin/vdbmarch" render "$ROOT/vdb_samples/sparse.json" -o "$C/exr/small.exr" --res 8x6 --spp 1 -q
 fi
 
-status=0
-for h in ${HARNESSES:-scene_json mesh exr vdb}; do
+# One harness: its log, its findings, a line of figures; returns 1 on a finding.
+run_harness() {
+  local h="$1" rc=0 extra=""
   echo "== fuzz_$h: $RUNS runs"
   mkdir -p "$BUILD/findings/$h"
-  rc=0
   # A small ASan quarantine: OpenEXR allocates what a damaged header asks
   # for (1.6 GB for a 1 kB file, then fails to read it, an error), and a
   # quarantine of such blocks would look like running out of memory.
   # OpenVDB's reader crashes on damaged input (the commands isolate it): count
   # those crashes across forked runs instead of stopping at the first.
-  extra=""
   [ "$h" = vdb ] && extra="-fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1"
   ASAN_OPTIONS="detect_leaks=1:quarantine_size_mb=16" "$BUILD/bin/fuzz_$h" "$C/$h" -runs="$RUNS" $extra \
       -max_total_time="${MAX_SECONDS:-3600}" -max_len=65536 -timeout=10 -rss_limit_mb=4096 -artifact_prefix="$BUILD/findings/$h/" -print_final_stats=1 \
       > "$BUILD/findings/$h.log" 2>&1 || rc=$?
   grep -E "^#[0-9]+ +(DONE|INITED)|stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|SUMMARY|crashes:" \
-      "$BUILD/findings/$h.log" || true
+      "$BUILD/findings/$h.log" | sed "s/^/fuzz_$h: /" || true
   if [ "$h" = vdb ]; then
     echo "fuzz_vdb: $(ls "$BUILD/findings/$h/" 2>/dev/null | wc -l) inputs that crash OpenVDB in-process (isolated by the commands; see docs/robustness.md)"
   elif [ $rc -ne 0 ] || ls "$BUILD/findings/$h/" 2>/dev/null | grep -q .; then
-    echo "fuzz_$h: exit $rc, findings in $BUILD/findings/$h/ (log: $BUILD/findings/$h.log)"; status=1
+    echo "fuzz_$h: exit $rc, findings in $BUILD/findings/$h/ (log: $BUILD/findings/$h.log)"; return 1
   fi
+  return 0
+}
+
+# PARALLEL=1 runs the harnesses side by side (one core each) instead of in turn.
+status=0
+pids=()
+for h in ${HARNESSES:-scene_json mesh exr vdb}; do
+  if [ "${PARALLEL:-0}" = 1 ]; then run_harness "$h" & pids+=($!); else run_harness "$h" || status=1; fi
 done
+for p in "${pids[@]}"; do wait "$p" || status=1; done
 exit $status

@@ -77,6 +77,7 @@ std::string vdbRenderCommand(const SceneDesc& d, const Scene& scene, double step
     if (d.lights.size() != 1 || d.lights[0].type != LightDesc::Type::Directional) refuse("it needs exactly one directional light");
     if (!d.surfaces.empty()) refuse("surfaces");
     if (!isBlack(d.background)) refuse("a non-black background");
+    if (!d.environment.file.empty()) refuse("an environment map");
     if (d.camera.type != CameraDesc::Type::Perspective) refuse("an orthographic camera");
     const double h = scene.media[0]->minVoxelSize();
     const CameraDesc& c = d.camera;

@@ -46,7 +46,7 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
             return {L, 0.f};
         }
         if (!hit) {
-            if (!lightsCounted) L += beta * scene.background;
+            if (!lightsCounted) L += beta * scene.environment.radiance(ray.d);
             return {L, diffuseBounces > 0 ? 0.f : average(beta)};  // a diffuse surface is opaque
         }
         ++ctx.counters.surfaceHits;

@@ -106,6 +106,15 @@ struct CacheSettings {
     int incidentOrder = -1;
 };
 
+// An environment map (scene key "environment"): a lat-long EXR of the
+// radiance arriving from each direction (docs/scene-format.md has the
+// orientation convention).
+struct EnvironmentDesc {
+    std::string file;        // empty: no map (the constant background applies)
+    float scale = 1;         // multiplies the texels
+    float rotationDeg = 0;   // turns the map about +Y (counter-clockwise seen from above)
+};
+
 struct SceneDesc {
     std::string file;     // scene file (or .vdb) the description came from
     std::string baseDir;  // relative paths resolve against this
@@ -114,6 +123,7 @@ struct SceneDesc {
     std::vector<MediumDesc> media;
     std::vector<SurfaceDesc> surfaces;
     Color background{0, 0, 0};
+    EnvironmentDesc environment;
     RenderSettings render;
     PhotonSettings photons;
     CacheSettings cache;

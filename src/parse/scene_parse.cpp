@@ -354,7 +354,7 @@ SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
     scene.baseDir = slash == std::string::npos ? "." : file.substr(0, slash == 0 ? 1 : slash);
     scene.jsonText = doc.dump();
     JsonReader root(doc, file, "");
-    root.allowOnly({"camera", "lights", "media", "surfaces", "background", "render", "photons", "cache"});
+    root.allowOnly({"camera", "lights", "media", "surfaces", "background", "environment", "render", "photons", "cache"});
     if (root.has("camera")) scene.camera = parseCamera(root.object("camera"));
     auto listOf = [&](const char* key) -> const Json& {
         const Json& v = root.raw(key);
@@ -400,6 +400,16 @@ SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
         }
     }
     scene.background = root.nonNegativeColor("background", Vec3(0));
+    if (root.has("environment")) {
+        JsonReader e = root.object("environment");
+        e.allowOnly({"file", "scale", "rotation"});
+        scene.environment.file = resolvePath(scene.baseDir, e.string("file"));
+        if (e.string("file").empty()) e.fail("file", "must name a lat-long EXR file");
+        scene.environment.scale = float(e.numberIn("scale", 1, 0, 1e30));
+        scene.environment.rotationDeg = float(e.numberIn("rotation", 0, -36000, 36000));
+        if (!isBlack(scene.background))
+            root.fail("environment", "cannot be given together with a non-black background: the map is the background");
+    }
     if (root.has("render")) scene.render = parseRender(root.object("render"));
     if (root.has("photons")) scene.photons = parsePhotons(root.object("photons"));
     if (root.has("cache")) scene.cache = parseCache(root.object("cache"));

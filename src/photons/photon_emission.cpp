@@ -358,6 +358,17 @@ PhotonEmitter PhotonEmitter::forEnvironment(const Color& radiance, const PhotonT
     return e;
 }
 
+PhotonEmitter PhotonEmitter::forEnvironment(const Environment& env, const PhotonTarget& target) {
+    if (!env.hasMap()) return forEnvironment(env.radiance(Vec3(0, 1, 0)), target);
+    // Expected power: the integral of L over the sphere x the disc's area.
+    PhotonEmitter e = forDisc(env.integral(), Vec3(0, 0, 1), target);
+    if (e.mKind == Kind::Disc) {
+        e.mKind = Kind::EnvironmentMap;
+        e.mEnvironment = &env;
+    }
+    return e;
+}
+
 // Disc of radius R (the bounding sphere's, already 1% larger) perpendicular
 // to the travel direction, centred 1.01 R upstream of the sphere's centre, so
 // every photon starts outside the sphere and the beam covers all of it.
@@ -424,6 +435,18 @@ bool PhotonEmitter::sample(const float u[4], EmittedPhoton& out) const {
             out.ray.o = sampleDisc(out.ray.d, u[0], u[1]);
             out.power = mWeight;
             return true;
+        case Kind::EnvironmentMap: {
+            // A sky direction w by texel power; the photon travels along -w
+            // and carries L(w) / pdf(w) x the disc's area.
+            Vec3 w;
+            float pdf;
+            Color radianceOverPdf;
+            if (!mEnvironment->sample(u[2], u[3], w, pdf, radianceOverPdf)) return false;
+            out.ray.d = -w;
+            out.ray.o = sampleDisc(out.ray.d, u[0], u[1]);
+            out.power = radianceOverPdf * (Pi * mRadius * mRadius);
+            return isFinite(out.power);
+        }
         case Kind::Quad:
             out.ray.o = mOrigin + mU * (u[0] - 0.5f) + mV * (u[1] - 0.5f);
             out.power = mWeight;

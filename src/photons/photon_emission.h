@@ -1,5 +1,5 @@
 // Emission sampling for the volume photon map (Jensen; the paper's eq. 4):
-// each light, and the constant background, becomes an emitter that shoots
+// each light, and the background or environment map, becomes an emitter that shoots
 // photons only where they can reach the part of the scene that scatters.
 //
 // Contract. For an emitter e and N independent samples, give each photon
@@ -13,6 +13,7 @@
 #pragma once
 
 #include "core/math.h"
+#include "scene/environment.h"
 #include "scene/lights.h"
 
 namespace vdbmarch {
@@ -57,6 +58,9 @@ public:
     // target: uniform direction, uniform on a disc perpendicular to it that
     // covers the target's bounding sphere.
     static PhotonEmitter forEnvironment(const Color& radiance, const PhotonTarget& target);
+    // An environment (map or constant): a map's directions are drawn by its
+    // texel power (Environment::sample); `env` must outlive the emitter.
+    static PhotonEmitter forEnvironment(const Environment& env, const PhotonTarget& target);
 
     // Total flux this emitter sends towards the target (what the photons
     // carry on average); 0 if it cannot reach the target.
@@ -66,7 +70,7 @@ public:
     bool sample(const float u[4], EmittedPhoton& out) const;
 
 private:
-    enum class Kind { None, Point, Spot, Disc, Environment, Quad, Sphere };
+    enum class Kind { None, Point, Spot, Disc, Environment, EnvironmentMap, Quad, Sphere };
 
     // Directional light (and, scaled, the environment): a disc covering the
     // target's bounding sphere; irradiance E perpendicular to dir.
@@ -85,6 +89,7 @@ private:
     float mRadius = 0;            // disc radius (directional, environment), sphere light radius
     float mDiscDist = 0;          // disc centre distance upstream of the target centre
     Vec3 mU, mV;                  // quad edge vectors
+    const Environment* mEnvironment = nullptr;  // environment maps
     // Spot only: the falloff as Light::sample evaluates it (its cosines as
     // 1 - cos), and the cone not sampled (directions outside it carry nothing).
     Vec3 mSpotAxis;

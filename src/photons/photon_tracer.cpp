@@ -220,8 +220,8 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
         s.pointLight = l.isPointLike();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }
-    if (maxComponent(scene.background) > 0) {
-        PhotonSource s{PhotonEmitter::forEnvironment(scene.background, target), nullptr, -1, Color(0), false, false, 0, 0};
+    if (!scene.environment.isBlack()) {
+        PhotonSource s{PhotonEmitter::forEnvironment(scene.environment, target), nullptr, -1, Color(0), false, false, 0, 0};
         s.power = s.emitter.power();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }

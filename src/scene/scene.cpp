@@ -11,7 +11,9 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     auto scene = std::make_unique<Scene>();
     scene->desc = desc;
     scene->camera = std::make_unique<Camera>(desc.camera);
-    scene->background = desc.background;
+    scene->environment = desc.environment.file.empty()
+                             ? Environment(desc.background)
+                             : Environment(desc.environment, str(desc.file, ": environment.file"));
     for (const auto& l : desc.lights) {
         scene->lights.emplace_back(l);
         scene->hasSphereLights = scene->hasSphereLights || l.type == LightDesc::Type::Sphere;

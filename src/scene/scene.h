@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scene/camera.h"
+#include "scene/environment.h"
 #include "scene/lights.h"
 #include "parse/scene_desc.h"
 #include "scene/surfaces.h"
@@ -38,7 +39,7 @@ public:
     std::vector<Region> regions;
     std::vector<SurfaceInfo> surfaces;
     std::unique_ptr<SurfaceSet> surfaceSet;
-    Color background;
+    Environment environment;  // the background colour or the environment map
     float step = 1, shadowStep = 1;  // world units
     float sceneScale = 1;            // size of the scene, for ray offsets
     bool hasSphereLights = false;

@@ -17,6 +17,10 @@ Color ScatterVertex::f(const Vec3& wi) const {
 
 float ScatterVertex::pdf(const Vec3& wi) const {
     if (pathPdf) return pathPdf(pathSampler, wi);
+    return fPdf(wi);
+}
+
+float ScatterVertex::fPdf(const Vec3& wi) const {
     if (phase) return phase->pdf(dot(wi, d));
     const Vec3 nf = dot(n, d) < 0 ? n : -n;
     return std::max(0.f, dot(wi, nf)) * InvPi;
@@ -40,22 +44,44 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         const float w = o.misWithPathHits && light.isSphere() ? powerHeuristic(ls.pdf, v.pdf(ls.wi)) : 1.f;
         L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) * w;
     }
-    if (o.sampleBackground && !isBlack(scene.background)) {
+    const Environment& env = scene.environment;
+    // An environment map is a light: sampled by its texel power, weighed by
+    // the power heuristic against the direction sampling of f, done by the
+    // path that goes on (misWithPathHits) or below (sampleBackground). A
+    // constant background is left to f's sampling alone (it is as good).
+    const bool envByLight = env.hasMap() && !env.isBlack() && (o.misWithPathHits || o.sampleBackground);
+    if (envByLight) {
+        Vec3 wi;
+        float pdf;
+        Color radianceOverPdf;
+        const float u1 = rng.uniform(), u2 = rng.uniform();
+        if (env.sample(u1, u2, wi, pdf, radianceOverPdf)) {
+            const Color f = v.f(wi);
+            if (!isBlack(f)) {
+                const float w = powerHeuristic(pdf, o.misWithPathHits ? v.pdf(wi) : v.fPdf(wi));
+                L += f * radianceOverPdf * (w * shadowTransmittance(ctx, region, origin, wi, Infinity, rng, o.transmittance));
+            }
+        }
+    }
+    if (o.sampleBackground && !env.isBlack()) {
         // One direction sampled by f: the pdf cancels f up to the mixture's weight.
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
         Color weight(1);
         Vec3 wi;
+        float pdf;
         if (v.phase) {
             // The scattered light leaves along -d, so the arriving light's
             // direction -wi is drawn around -d: wi around d.
-            float pdf;
             wi = v.phase->sample(v.d, u0, u1, u2, weight, pdf);
             if (!(pdf > 0)) return L;
         } else {
-            wi = directionAround(nf, std::sqrt(1 - u1), u2);
+            const float cosTheta = std::sqrt(1 - u1);
+            wi = directionAround(nf, cosTheta, u2);
             weight = v.albedo;
+            pdf = cosTheta * InvPi;
         }
-        L += weight * scene.background * shadowTransmittance(ctx, region, origin, wi, Infinity, rng, o.transmittance);
+        const float w = envByLight ? powerHeuristic(pdf, env.pdf(wi)) : 1.f;
+        L += weight * env.radiance(wi) * (w * shadowTransmittance(ctx, region, origin, wi, Infinity, rng, o.transmittance));
     }
     return L;
 }

@@ -1,8 +1,8 @@
 // Next-event estimation, written once for the marchers' L_i and the
 // reference tracer: at a scattering point in a medium (phase mixture) or on
 // a diffuse surface (albedo cos / pi), a sample of every light with its
-// shadow-ray transmittance, and optionally one sample of the constant
-// background.
+// shadow-ray transmittance, the environment map as a light, and optionally
+// one direction sampled by f towards the background.
 #pragma once
 
 #include "core/rng.h"
@@ -36,6 +36,8 @@ struct ScatterVertex {
     Color f(const Vec3& wi) const;
     // Solid-angle pdf with which the path itself would sample wi (MIS).
     float pdf(const Vec3& wi) const;
+    // Solid-angle pdf of sampling f itself (phase, or cosine on a surface).
+    float fPdf(const Vec3& wi) const;
 };
 
 struct DirectLightOptions {
@@ -43,7 +45,8 @@ struct DirectLightOptions {
     // The path goes on from here by sampling f, and counts the sphere lights
     // it hits: weight both strategies by the power heuristic.
     bool misWithPathHits = false;
-    // The path does not go on: sample the constant background here (by f).
+    // The path does not go on: sample the background here (by f, and an
+    // environment map by its texels too, the two weighed by MIS).
     bool sampleBackground = true;
     // Leave point and spot lights out: photons carry their light here.
     bool skipPointLights = false;

@@ -12,7 +12,8 @@ namespace vdbmarch {
 namespace {
 
 // Next-event estimation of the path: ratio tracking; sphere lights are also
-// hit by the path, the background only by the path.
+// hit by the path, a constant background only by the path, an environment
+// map by both.
 DirectLightOptions nextEventOptions(const PathState& st) {
     return {TransmittanceEstimator::RatioTracking, true, false, st.pointLightsByPhotons};
 }
@@ -99,7 +100,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             return {L, 0.f};
         }
         if (!hit) {
-            L += beta * scene.background;
+            // An environment map was also sampled by next-event estimation
+            // at the last vertex (direct_light.cpp): weigh the two by MIS.
+            const Environment& env = scene.environment;
+            const float w = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(ray.d)) : 1.f;
+            L += beta * env.radiance(ray.d) * w;
             return {L, st.depth == startDepth && surfaceBounces == 0 ? average(beta) : 0.f};
         }
         ++ctx.counters.surfaceHits;
