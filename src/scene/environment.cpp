@@ -80,7 +80,10 @@ void Environment::directionToUv(const Vec3& d, float& u, float& v) {
     u = float(std::atan2(double(d.x), double(-d.z)) / (2 * PiD));
     if (u < 0) u += 1;
     if (!(u < 1)) u = 0;
-    v = float(std::acos(double(clamp(d.y, -1.f, 1.f))) / PiD);
+    // theta from atan2: near the poles y rounds to +-1 while x and z still
+    // hold sin(theta) accurately.
+    v = float(std::atan2(std::hypot(double(d.x), double(d.z)), double(d.y)) / PiD);
+    if (!(v < 1)) v = std::nextafter(1.f, 0.f);
 }
 
 Vec3 Environment::uvToDirection(float u, float v) {
@@ -112,22 +115,26 @@ bool Environment::sample(float u1, float u2, Vec3& w, float& pdf, Color& radianc
     if (isBlack()) return false;
     float u, v, puv;
     mDistribution.sample(u1, u2, u, v, puv);
-    const float sinTheta = std::sin(Pi * v);
-    if (!(puv > 0) || !(sinTheta > 0)) return false;
-    pdf = puv / (2 * Pi * Pi * sinTheta);
+    if (!(puv > 0)) return false;
     w = toWorld(uvToDirection(u, v));
-    radianceOverPdf = texel(u, v) / pdf;
-    return pdf > 0 && std::isfinite(pdf);
+    // The pdf and radiance of the direction as pdf() and radiance() see it:
+    // a (u, v) on a texel edge may round into the neighbour on the way to a
+    // direction and back, and MIS needs the two to agree exactly.
+    pdf = this->pdf(w);
+    if (!(pdf > 0) || !std::isfinite(pdf)) return false;
+    radianceOverPdf = radiance(w) / pdf;
+    return true;
 }
 
 float Environment::pdf(const Vec3& w) const {
     if (!hasMap()) return uniformSpherePdf();
     if (isBlack()) return 0;
     float u, v;
-    directionToUv(toLocal(w), u, v);
-    const float sinTheta = std::sin(Pi * v);
+    const Vec3 local = toLocal(w);
+    directionToUv(local, u, v);
+    const double sinTheta = std::hypot(double(local.x), double(local.z)) / double(length(local));
     if (!(sinTheta > 0)) return 0;
-    return mDistribution.pdf(u, v) / (2 * Pi * Pi * sinTheta);
+    return float(double(mDistribution.pdf(u, v)) / (2 * PiD * PiD * sinTheta));
 }
 
 Color Environment::integral() const { return hasMap() ? mIntegral : mConstant * (4 * Pi); }
