@@ -19,6 +19,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <new>
 #include <cstdint>
 #include <utility>
@@ -35,6 +36,51 @@ int channelCount(Imf::InputFile& in) {
 
 const char* const RgbaNames[4] = {"R", "G", "B", "A"};
 
+// OpenEXR allocates (and clears) what an attribute's size field claims
+// before reading its value: fuzzing found a 1.3 kB file whose string
+// attribute asks for gigabytes. Walk the header(s) first, as the format
+// lays them out (magic, version, then per header: name\0 type\0 int32 size,
+// value; a NUL name ends a header; multi-part files end with an empty
+// header), and refuse any size that the rest of the file cannot hold.
+void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
+    std::error_code ec;
+    const uint64_t fileBytes = uint64_t(std::filesystem::file_size(path, ec));
+    unsigned char head[8];
+    if (ec || std::fread(head, 1, 8, f) != 8) return;  // OpenEXR reports short files itself
+    const bool multiPart = (head[5] & 0x10) != 0;  // version flag bit 12
+    auto readString = [&](std::string& s) {
+        s.clear();
+        for (int c; (c = std::fgetc(f)) != 0;) {
+            if (c == EOF || s.size() >= 255)
+                throw InputError(str("'", path, "': damaged OpenEXR header (an attribute name or type runs on)"));
+            s.push_back(char(c));
+        }
+    };
+    std::string name, type;
+    while (true) {
+        while (true) {
+            readString(name);
+            if (name.empty()) break;
+            readString(type);
+            unsigned char b[4];
+            if (std::fread(b, 1, 4, f) != 4)
+                throw InputError(str("'", path, "': damaged OpenEXR header (cut inside attribute '", name, "')"));
+            const int32_t size = int32_t(uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24);
+            const long pos = std::ftell(f);
+            const uint64_t left = pos >= 0 && uint64_t(pos) <= fileBytes ? fileBytes - uint64_t(pos) : 0;
+            if (size < 0 || uint64_t(size) > left)
+                throw InputError(str("'", path, "': damaged OpenEXR header: attribute '", name, "' (", type, ") claims ",
+                                     size, " bytes, but only ", left, " follow"));
+            std::fseek(f, size, SEEK_CUR);
+        }
+        if (!multiPart) break;
+        // Multi-part: headers follow one another until an empty one.
+        const int c = std::fgetc(f);
+        if (c == 0 || c == EOF) break;
+        std::ungetc(c, f);
+    }
+}
+
 // Missing / unreadable files are IoError; everything OpenEXR rejects after
 // that is a bad input file.
 void checkReadableExr(const std::string& path) {
@@ -43,6 +89,8 @@ void checkReadableExr(const std::string& path) {
     std::fclose(f);
     if (!Imf::isOpenExrFile(path.c_str()))
         throw InputError(str("'", path, "' is not an OpenEXR file"));
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+    if (file) checkExrAttributeSizes(path, file.get());
 }
 
 // Runs `fn` with an open InputFile, translating OpenEXR's exceptions into ours.

@@ -127,6 +127,27 @@ TEST_F(ImageIoTest, ReadExrRefusesADataWindowTheFileCannotHold) {
     EXPECT_CONTAINS(msg, "2686984x257");
 }
 
+// Fuzzing finding (fuzz_exr, timeout): a string attribute whose size field
+// claims ~1.7 GB made OpenEXR allocate and clear that much before failing
+// (over 10 s under ASan). The header walk refuses it from the size alone.
+TEST_F(ImageIoTest, ReadExrRefusesAnAttributeSizeTheFileCannotHold) {
+    writeExr(path("a.exr"), makeTestImage(8, 8), {{"vdbmarch:note", "hello"}});
+    std::string bytes = readBytes(path("a.exr"));
+    const std::string key = std::string("vdbmarch:note") + '\0' + "string" + '\0';
+    const size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const int32_t huge = 1744830468;
+    std::memcpy(&bytes[at + key.size()], &huge, sizeof huge);
+    writeText(path("huge.exr"), bytes);
+    const std::string msg = errorOf<InputError>([&] { readExr(path("huge.exr")); });
+    EXPECT_CONTAINS(msg, path("huge.exr"));
+    EXPECT_CONTAINS(msg, "vdbmarch:note");
+    EXPECT_CONTAINS(msg, "1744830468");
+    // The untouched file still reads, attributes and all.
+    EXPECT_EQ(readExr(path("a.exr")).width, 8);
+    EXPECT_EQ(readExrStringAttributes(path("a.exr")).size(), 1u);
+}
+
 TEST_F(ImageIoTest, ExrRejectsReservedAttributeWithoutTouchingExistingFile) {
     writeText(path("keep.exr"), "old contents");
     EXPECT_THROW(writeExr(path("keep.exr"), makeTestImage(2, 2), {{"compression", "none"}}), InputError);
