@@ -35,7 +35,7 @@ std::string cacheSummary(const RadianceCache& c) {
             lo = std::min(lo, v);
             hi = std::max(hi, v);
         }
-        int l = int(std::sqrt(float(k)));
+        int l = shBand(k);
         o << "  f(l=" << l << ", m=" << k - l * (l + 1) << ") [" << (c.cells.empty() ? 0.f : lo) << ", "
           << (c.cells.empty() ? 0.f : hi) << "]\n";
     }

@@ -26,11 +26,72 @@ openvdb::math::Transform::Ptr levelTransform(const Vec3& origin, float h) {
     return t;
 }
 
+// `where` names the holder in messages: "the file metadata" or "grid 'x'".
 template <typename T>
-T metaValue(const openvdb::GridBase& g, const std::string& key, const std::string& file) {
-    auto m = g.getMetadata<openvdb::TypedMetadata<T>>(key);
-    if (!m) throw InputError(str(file, ": grid '", g.getName(), "' has no metadata '", key, "': not a vdbmarch cache"));
+T metaValue(const openvdb::MetaMap& meta, const std::string& where, const std::string& key, const std::string& file) {
+    auto m = meta.getMetadata<openvdb::TypedMetadata<T>>(key);
+    if (!m) throw InputError(str(file, ": ", where, " lacks the key '", key, "' (or it has another type): ",
+                                 "not a vdbmarch cache"));
     return m->value();
+}
+
+constexpr float Y00 = 0.28209479177387814f;  // 1 / (2 sqrt(pi)): Y_00, and f_00 Y_00 = mean of L_i
+
+// The keys load() reads: written on the file and repeated on every
+// coefficient grid, so a cache re-saved by a tool that keeps grid metadata
+// but not file metadata still loads.
+void insertCacheKeys(openvdb::MetaMap& m, const RadianceCache& c) {
+    const CacheInfo& info = c.info;
+    m.insertMeta("vdbmarch_cache_version", openvdb::Int32Metadata(RadianceCache::FormatVersion));
+    m.insertMeta("vdbmarch_version", openvdb::StringMetadata(info.version));
+    m.insertMeta("sh_order", openvdb::Int32Metadata(info.shOrder));
+    m.insertMeta("sh_order_requested", openvdb::Int32Metadata(info.requestedOrder));
+    m.insertMeta("levels", openvdb::Int32Metadata(c.levels));
+    m.insertMeta("origin", openvdb::Vec3SMetadata(openvdb::Vec3s(c.origin.x, c.origin.y, c.origin.z)));
+    m.insertMeta("phase_g", openvdb::FloatMetadata(info.meanG));
+    m.insertMeta("photons", openvdb::Int64Metadata(int64_t(info.photons)));
+    m.insertMeta("photon_paths", openvdb::Int64Metadata(int64_t(info.paths)));
+    m.insertMeta("photon_batches", openvdb::Int32Metadata(int32_t(info.batches)));
+    m.insertMeta("seed", openvdb::Int64Metadata(int64_t(info.seed)));
+    m.insertMeta("k", openvdb::Int32Metadata(info.k));
+    m.insertMeta("quality", openvdb::FloatMetadata(info.quality));
+    m.insertMeta("adaptive", openvdb::BoolMetadata(info.adaptive));
+    m.insertMeta("min_cell", openvdb::FloatMetadata(info.minCell));
+    m.insertMeta("scene_hash", openvdb::StringMetadata(info.sceneHash));
+}
+
+// What the numbers mean, for other tools (file metadata only); the basis
+// is the one of cache/sh.h, whose tests check these statements.
+void insertBasisKeys(openvdb::MetaMap& m) {
+    m.insertMeta("description", openvdb::StringMetadata(
+        "vdbmarch radiance cache: spherical-harmonics coefficients of the in-scattered radiance L_i at cell "
+        "centres (one float grid per coefficient and level), and L_i averaged over directions (grid Li)"));
+    m.insertMeta("Li_quantity", openvdb::StringMetadata(
+        "in-scattered radiance L_i(x, wo) = integral over w of p(w . wo) L(x, w) dw (eq. 3): incident radiance "
+        "L over the travel direction w of the arriving light, convolved with the phase function p (eq. 27), "
+        "so the phase function is already applied; wo is the direction the scattered light travels in "
+        "(towards a viewer at e: wo = normalize(e - x)). Estimated from the volume photon map; scalar: the "
+        "mean of the RGB channels. The radiance scattered towards wo per unit length is sigma_s(x) L_i(x, wo)"));
+    m.insertMeta("Li_unit", openvdb::StringMetadata("W m^-2 sr^-1 (radiance in the scene's units)"));
+    m.insertMeta("Li_reconstruction", openvdb::StringMetadata(
+        "L_i(x, wo) = sum over l = 0..sh_order, m = -l..l of Li_sh_<l>_<m>(x) Y_lm(wo); "
+        "mean over directions = Li_sh_0_0(x) Y_00 = grid Li"));
+    m.insertMeta("sh_basis", openvdb::StringMetadata(
+        "real spherical harmonics, orthonormal on the unit sphere, Condon-Shortley phase included, z the polar "
+        "axis (theta = acos z, phi = atan2(y, x)): Y_l0 = K_l0 P_l^0(cos theta); "
+        "Y_lm = sqrt(2) K_lm P_l^m(cos theta) cos(m phi) for m > 0; "
+        "Y_lm = sqrt(2) K_l|m| P_l^|m|(cos theta) sin(|m| phi) for m < 0; "
+        "K_lm = sqrt((2l+1)/(4 pi) (l-|m|)!/(l+|m|)!); P_l^m with the (-1)^m phase. "
+        "So Y_00 = 0.282095, Y_1,-1 = -0.488603 y, Y_1,0 = 0.488603 z, Y_1,1 = -0.488603 x "
+        "(Sloan, Stupid Spherical Harmonics Tricks, 2008)"));
+    m.insertMeta("sh_normalisation", openvdb::StringMetadata(
+        "orthonormal: integral over the unit sphere of Y_lm Y_l'm' = 1 if (l, m) = (l', m') else 0"));
+    m.insertMeta("sh_condon_shortley_phase", openvdb::BoolMetadata(true));
+    m.insertMeta("sh_coefficient_order", openvdb::StringMetadata(
+        "band by band, c = l(l+1) + m for l = 0..sh_order, m = -l..l (metadata sh_coefficient of each grid)"));
+    m.insertMeta("sh_grid_names", openvdb::StringMetadata(
+        "Li_sh_<l>_<m>, a negative m spelt m<|m|> (Li_sh_1_m1 is l = 1, m = -1); adaptive caches add "
+        "_level<n> (level 0 the coarsest, each level halves the cell), and Li becomes Li_level<n>"));
 }
 
 // A trailer after the VDB data (OpenVDB readers ignore trailing bytes): a tag
@@ -84,9 +145,14 @@ RadianceCache::RadianceCache(RadianceCache&&) noexcept = default;
 RadianceCache& RadianceCache::operator=(RadianceCache&&) noexcept = default;
 
 std::string cacheGridName(int coefficient, int level, int levels) {
-    std::string name = str("Li_sh", coefficient < 10 ? "0" : "", coefficient);
+    const int l = shBand(coefficient), m = coefficient - l * (l + 1);
+    std::string name = str("Li_sh_", l, "_", m < 0 ? "m" : "", std::abs(m));
     if (levels > 1) name += str("_level", level);
     return name;
+}
+
+std::string cacheMeanGridName(int level, int levels) {
+    return levels > 1 ? str("Li_level", level) : std::string("Li");
 }
 
 void RadianceCache::finalize() {
@@ -135,8 +201,13 @@ int64_t RadianceCache::Query::find(const Vec3& x) {
 void RadianceCache::save(const std::string& path) const {
     initOpenVdb();
     const int count = coefficientCount();
+    openvdb::MetaMap fileMeta;
+    insertCacheKeys(fileMeta, *this);
+    insertBasisKeys(fileMeta);
+    fileMeta.insertMeta("cell_size", openvdb::FloatMetadata(baseCell));
     openvdb::GridPtrVec grids;
     std::vector<std::vector<openvdb::FloatGrid::Ptr>> perLevel{size_t(levels)};
+    std::vector<openvdb::FloatGrid::Ptr> means;
     for (int l = 0; l < levels; ++l) {
         auto xform = levelTransform(origin, cellSize(l));
         for (int c = 0; c < count; ++c) {
@@ -144,48 +215,50 @@ void RadianceCache::save(const std::string& path) const {
             g->setName(cacheGridName(c, l, levels));
             g->setTransform(xform);
             g->setGridClass(openvdb::GRID_FOG_VOLUME);
-            g->insertMeta("vdbmarch_cache_version", openvdb::Int32Metadata(FormatVersion));
-            g->insertMeta("vdbmarch_version", openvdb::StringMetadata(info.version));
-            g->insertMeta("sh_order", openvdb::Int32Metadata(info.shOrder));
-            g->insertMeta("sh_order_requested", openvdb::Int32Metadata(info.requestedOrder));
+            insertCacheKeys(*g, *this);
+            g->insertMeta("cell_size", openvdb::FloatMetadata(cellSize(l)));
+            g->insertMeta("level", openvdb::Int32Metadata(l));
             g->insertMeta("sh_coefficient", openvdb::Int32Metadata(c));
-            int band = int(std::sqrt(float(c)));
+            const int band = shBand(c);
             g->insertMeta("sh_l", openvdb::Int32Metadata(band));
             g->insertMeta("sh_m", openvdb::Int32Metadata(c - band * (band + 1)));
-            g->insertMeta("level", openvdb::Int32Metadata(l));
-            g->insertMeta("levels", openvdb::Int32Metadata(levels));
-            g->insertMeta("cell_size", openvdb::FloatMetadata(cellSize(l)));
-            g->insertMeta("origin", openvdb::Vec3SMetadata(openvdb::Vec3s(origin.x, origin.y, origin.z)));
-            g->insertMeta("phase_g", openvdb::FloatMetadata(info.meanG));
-            g->insertMeta("photons", openvdb::Int64Metadata(int64_t(info.photons)));
-            g->insertMeta("photon_paths", openvdb::Int64Metadata(int64_t(info.paths)));
-            g->insertMeta("photon_batches", openvdb::Int32Metadata(int32_t(info.batches)));
-            g->insertMeta("seed", openvdb::Int64Metadata(int64_t(info.seed)));
-            g->insertMeta("k", openvdb::Int32Metadata(info.k));
-            g->insertMeta("quality", openvdb::FloatMetadata(info.quality));
-            g->insertMeta("adaptive", openvdb::BoolMetadata(info.adaptive));
-            g->insertMeta("min_cell", openvdb::FloatMetadata(info.minCell));
-            g->insertMeta("scene_hash", openvdb::StringMetadata(info.sceneHash));
             g->insertMeta("description", openvdb::StringMetadata(
-                "vdbmarch in-scattered radiance cache: real SH coefficient f_lm of L_i (W/m^2/sr) at cell centres"));
+                str("vdbmarch radiance cache: real SH coefficient f_lm (l = ", band, ", m = ", c - band * (band + 1),
+                    ") of the in-scattered radiance L_i (W m^-2 sr^-1); basis in the file metadata sh_*")));
             perLevel[size_t(l)].push_back(g);
             grids.push_back(g);
         }
+        // A scalar a viewer can show as is, without the SH basis.
+        auto mean = openvdb::FloatGrid::create(0.f);
+        mean->setName(cacheMeanGridName(l, levels));
+        mean->setTransform(xform);
+        mean->setGridClass(openvdb::GRID_FOG_VOLUME);
+        mean->insertMeta("level", openvdb::Int32Metadata(l));
+        mean->insertMeta("cell_size", openvdb::FloatMetadata(cellSize(l)));
+        mean->insertMeta("description", openvdb::StringMetadata(
+            "vdbmarch radiance cache: L_i averaged over directions, Li_sh_0_0 * Y_00 (W m^-2 sr^-1); "
+            "not read back by vdbmarch"));
+        means.push_back(mean);
+        grids.push_back(mean);
     }
     std::vector<std::vector<openvdb::FloatGrid::Accessor>> acc{size_t(levels)};
-    for (int l = 0; l < levels; ++l)
+    std::vector<openvdb::FloatGrid::Accessor> meanAcc;
+    for (int l = 0; l < levels; ++l) {
         for (auto& g : perLevel[size_t(l)]) acc[size_t(l)].push_back(g->getAccessor());
+        meanAcc.push_back(means[size_t(l)]->getAccessor());
+    }
     for (size_t i = 0; i < cells.size(); ++i) {
         const CacheCell& cell = cells[i];
         const float* f = cellCoefficients(i);
-        for (int c = 0; c < count; ++c)
-            acc[size_t(cell.level)][size_t(c)].setValueOn(openvdb::Coord(cell.i, cell.j, cell.k), f[c]);
+        const openvdb::Coord xyz(cell.i, cell.j, cell.k);
+        for (int c = 0; c < count; ++c) acc[size_t(cell.level)][size_t(c)].setValueOn(xyz, f[c]);
+        meanAcc[size_t(cell.level)].setValueOn(xyz, f[0] * Y00);
     }
     AtomicFile out(path);
     try {
         openvdb::io::File file(out.tempPath());
         file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-        file.write(grids);
+        file.write(grids, fileMeta);
         file.close();
     } catch (const openvdb::Exception& e) {
         throw IoError(str(path, ": cannot write the cache: ", e.what()));
@@ -238,44 +311,67 @@ RadianceCache RadianceCache::load(const std::string& path) {
         warn(str(path, ": no vdbmarch checksum (the file was truncated, or re-saved by another VDB tool): "
                        "loading it unverified"));
     openvdb::GridPtrVecPtr grids;
+    openvdb::MetaMap::Ptr fileMeta;
     try {
         openvdb::io::File file(path);
         file.open(/*delayLoad=*/false);
         grids = file.getGrids();
+        fileMeta = file.getMetadata();
         file.close();
     } catch (const std::exception& e) {
         throw InputError(str(path, ": not a readable VDB cache file (", e.what(), ")"));
     }
-    // Level 0, coefficient 0 carries the metadata every grid repeats.
-    openvdb::FloatGrid::Ptr first;
+    // The cache keys: on the file, or (re-saved by a tool that keeps only
+    // grid metadata) on the level-0 grid of coefficient 0, which repeats them.
+    const std::string firstName = cacheGridName(0, 0, 1), firstLevelName = cacheGridName(0, 0, 2);
+    const openvdb::MetaMap* meta = nullptr;
+    std::string where;
+    if (fileMeta && (*fileMeta)["vdbmarch_cache_version"]) {
+        meta = fileMeta.get();
+        where = "the file metadata";
+    }
     for (auto& g : *grids)
-        if (g && (g->getName() == "Li_sh00" || g->getName() == "Li_sh00_level0"))
-            first = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-    if (!first) throw InputError(str(path, ": no grid 'Li_sh00' or 'Li_sh00_level0': not a vdbmarch cache"));
+        if (!meta && g && (g->getName() == firstName || g->getName() == firstLevelName)) {
+            meta = g.get();
+            where = str("grid '", g->getName(), "'");
+        }
+    // Another format's layout (version 1 named its grids Li_sh00, ...): any
+    // grid's version says which, so the message can name it.
+    for (auto& g : *grids)
+        if (!meta && g && (*g)["vdbmarch_cache_version"]) {
+            meta = g.get();
+            where = str("grid '", g->getName(), "'");
+        }
+    if (!meta)
+        throw InputError(str(path, ": no metadata 'vdbmarch_cache_version' and no grid '", firstName,
+                             "': not a vdbmarch cache"));
+    const int version = metaValue<int32_t>(*meta, where, "vdbmarch_cache_version", path);
+    if (version != FormatVersion) {
+        auto writer = meta->getMetadata<openvdb::StringMetadata>("vdbmarch_version");
+        throw InputError(str(path, ": cache format version ", version,
+                             writer ? str(" (written by vdbmarch ", writer->value(), ")") : std::string(),
+                             "; this vdbmarch (", VDBMARCH_VERSION, ") reads cache format version ", FormatVersion,
+                             " only: bake the cache again (vdbmarch bake SCENE -o ", path, ")"));
+    }
     RadianceCache c;
-    int version = metaValue<int32_t>(*first, "vdbmarch_cache_version", path);
-    if (version != FormatVersion)
-        throw InputError(str(path, ": cache format version ", version, " is not the supported version ", FormatVersion,
-                             "; bake it again"));
-    c.info.version = metaValue<std::string>(*first, "vdbmarch_version", path);
-    c.info.shOrder = metaValue<int32_t>(*first, "sh_order", path);
-    c.info.requestedOrder = metaValue<int32_t>(*first, "sh_order_requested", path);
-    c.levels = metaValue<int32_t>(*first, "levels", path);
-    c.baseCell = metaValue<float>(*first, "cell_size", path);
-    openvdb::Vec3s o = metaValue<openvdb::Vec3s>(*first, "origin", path);
+    auto get = [&](auto tag, const char* key) { return metaValue<decltype(tag)>(*meta, where, key, path); };
+    c.info.version = get(std::string(), "vdbmarch_version");
+    c.info.shOrder = get(int32_t(), "sh_order");
+    c.info.requestedOrder = get(int32_t(), "sh_order_requested");
+    c.levels = get(int32_t(), "levels");
+    c.baseCell = get(float(), "cell_size");
+    openvdb::Vec3s o = get(openvdb::Vec3s(), "origin");
     c.origin = Vec3(o.x(), o.y(), o.z());
-    c.info.meanG = metaValue<float>(*first, "phase_g", path);
-    c.info.photons = uint64_t(metaValue<int64_t>(*first, "photons", path));
-    c.info.paths = uint64_t(metaValue<int64_t>(*first, "photon_paths", path));
-    c.info.seed = uint64_t(metaValue<int64_t>(*first, "seed", path));
-    // Caches baked before progressive refinement hold one batch.
-    if ((*first)["photon_batches"])
-        c.info.batches = uint32_t(std::max(1, metaValue<int32_t>(*first, "photon_batches", path)));
-    c.info.k = metaValue<int32_t>(*first, "k", path);
-    c.info.quality = metaValue<float>(*first, "quality", path);
-    c.info.adaptive = metaValue<bool>(*first, "adaptive", path);
-    c.info.minCell = metaValue<float>(*first, "min_cell", path);
-    c.info.sceneHash = metaValue<std::string>(*first, "scene_hash", path);
+    c.info.meanG = get(float(), "phase_g");
+    c.info.photons = uint64_t(get(int64_t(), "photons"));
+    c.info.paths = uint64_t(get(int64_t(), "photon_paths"));
+    c.info.seed = uint64_t(get(int64_t(), "seed"));
+    c.info.batches = uint32_t(std::max(1, get(int32_t(), "photon_batches")));
+    c.info.k = get(int32_t(), "k");
+    c.info.quality = get(float(), "quality");
+    c.info.adaptive = get(bool(), "adaptive");
+    c.info.minCell = get(float(), "min_cell");
+    c.info.sceneHash = get(std::string(), "scene_hash");
     if (c.info.shOrder < 0 || c.info.shOrder > MaxShOrder)
         throw InputError(str(path, ": metadata sh_order = ", c.info.shOrder, " is outside [0, ", MaxShOrder, "]"));
     if (c.levels < 1 || c.levels > 16)
@@ -303,7 +399,7 @@ RadianceCache RadianceCache::load(const std::string& path) {
                 float v;
                 if (!acc[size_t(k)].probeValue(xyz, v))
                     throw InputError(str(path, ": cache grid '", coeffGrids[size_t(k)]->getName(),
-                                         "' lacks the cell ", xyz, " that 'Li_sh00' has"));
+                                         "' lacks the cell ", xyz, " that '", coeffGrids[0]->getName(), "' has"));
                 if (!std::isfinite(v))
                     throw InputError(str(path, ": cache grid '", coeffGrids[size_t(k)]->getName(), "' holds ", v,
                                          " at ", xyz));

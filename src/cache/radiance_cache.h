@@ -42,7 +42,9 @@ struct CacheCell {
 
 class RadianceCache {
 public:
-    static constexpr int FormatVersion = 1;
+    // 2: grids Li_sh_<l>_<m> (1: Li_sh<c>), a mean-radiance grid Li, and
+    // file metadata spelling out the SH basis.
+    static constexpr int FormatVersion = 2;
 
     RadianceCache();
     ~RadianceCache();
@@ -94,10 +96,12 @@ public:
     };
 
     // Writes the cache as VDB float grids (one per coefficient and level,
-    // grid class fog volume) with metadata; atomically.
+    // grid class fog volume, plus the mean radiance Li per level) with file
+    // and grid metadata (docs/scene-format.md, "The cache file"); atomically.
     void save(const std::string& path) const;
     // Reads a cache written by save(); throws InputError naming the file
-    // (and the grid) for missing, truncated or inconsistent files.
+    // (and the grid) for missing, truncated or inconsistent files, and for a
+    // cache of another format version (naming both versions).
     static RadianceCache load(const std::string& path);
 
     // Writes L_i(wo) of every cell as one float grid per level (for viewing).
@@ -109,8 +113,13 @@ private:
     std::unique_ptr<Index> mIndex;
 };
 
-// Grid name of coefficient `c` at `level`: "Li_sh<c>" for a single-level
-// cache, "Li_sh<c>_level<level>" otherwise (documented in docs/scene-format.md).
+// Grid name of coefficient `c` = shIndex(l, m) at `level`: "Li_sh_<l>_<m>"
+// for a single-level cache, "Li_sh_<l>_<m>_level<level>" otherwise. A
+// negative m is spelt "m<|m|>" (Li_sh_1_m1), so that every name is an
+// identifier: Houdini binds volumes as @name in VEX, where '-' cannot appear
+// (documented in docs/scene-format.md).
 std::string cacheGridName(int coefficient, int level, int levels);
+// The grid of mean radiance over directions, f_00 Y_00: "Li" or "Li_level<level>".
+std::string cacheMeanGridName(int level, int levels);
 
 }  // namespace vdbmarch

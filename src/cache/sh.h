@@ -35,6 +35,13 @@ constexpr int shCount(int order) { return (order + 1) * (order + 1); }
 // Flat index of Y_lm, -l <= m <= l.
 constexpr int shIndex(int l, int m) { return l * (l + 1) + m; }
 
+// Band l of flat index c, the inverse of shIndex (then m = c - l (l + 1)).
+constexpr int shBand(int c) {
+    int l = 0;
+    while ((l + 1) * (l + 1) <= c) ++l;
+    return l;
+}
+
 // Y_lm(w) for all l <= order (0 <= order <= MaxShOrder) into
 // out[0 .. shCount(order)); w must be unit length. Runs once per camera ray
 // and per photon per cell, so orders <= 3 use the expanded polynomials and

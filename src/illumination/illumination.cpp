@@ -174,7 +174,9 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // Product sampling of continuation directions reads the non-direct
     // incident radiance (band 3), estimated beside eq. 27.
     if (rq.cache && rs.li == LiSource::Path && rs.productSampling) rq.cacheSettings.incidentOrder = 3;
-    else if (!options.cacheFile.empty())
+    // Only when the cache goes unread (an `else` above warned for every
+    // cached method without product sampling, which loads the file).
+    if (!rq.cache && !options.cacheFile.empty())
         warn(str(options.cacheFile, ": method ", methodName(method), " with render.li = \"", liSourceName(rs.li),
                  "\" does not read the cache; ignored"));
     // Shadow rays compute the direct light. With photons, the photon map

@@ -124,6 +124,14 @@ TEST(ShBasis, MatchesTrigonometricDefinition) {
     evalSh(1, Vec3(0.6f, 0, 0.8f), Y.data());
     EXPECT_NEAR(Y[shIndex(1, 1)], -0.4886025f * 0.6f, 1e-6);
     EXPECT_NEAR(Y[shIndex(1, 0)], 0.4886025f * 0.8f, 1e-6);
+    // The cache file states Y_1,-1 = -0.488603 y (metadata sh_basis).
+    evalSh(1, Vec3(0, 0.6f, 0.8f), Y.data());
+    EXPECT_NEAR(Y[shIndex(1, -1)], -0.4886025f * 0.6f, 1e-6);
+}
+
+TEST(ShBasis, BandInvertsTheFlatIndex) {
+    for (int l = 0; l <= MaxShOrder; ++l)
+        for (int m = -l; m <= l; ++m) EXPECT_EQ(shBand(shIndex(l, m)), l) << "l " << l << " m " << m;
 }
 
 TEST(ShBasis, ExpandedPathMatchesRecurrence) {

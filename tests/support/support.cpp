@@ -84,11 +84,16 @@ std::string shellQuote(const std::string& s) {
 
 CliResult runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& captureDir,
                  int timeoutSeconds) {
+    std::string cmd = shellQuote(VDBMARCH_BINARY);
+    for (const auto& a : args) cmd += " " + shellQuote(a);
+    return runShell(cmd, cwd, captureDir, timeoutSeconds);
+}
+
+CliResult runShell(const std::string& command, const std::string& cwd, const std::string& captureDir,
+                   int timeoutSeconds) {
     const std::string outFile = (fs::path(captureDir) / "cli_stdout.txt").string();
     const std::string errFile = (fs::path(captureDir) / "cli_stderr.txt").string();
-    std::string cmd = "cd " + shellQuote(cwd) + " && timeout " + std::to_string(timeoutSeconds) + " " +
-                      shellQuote(VDBMARCH_BINARY);
-    for (const auto& a : args) cmd += " " + shellQuote(a);
+    std::string cmd = "cd " + shellQuote(cwd) + " && timeout " + std::to_string(timeoutSeconds) + " " + command;
     cmd += " >" + shellQuote(outFile) + " 2>" + shellQuote(errFile) + " </dev/null";
     auto t0 = std::chrono::steady_clock::now();
     int status = std::system(cmd.c_str());
@@ -98,6 +103,10 @@ CliResult runCli(const std::vector<std::string>& args, const std::string& cwd, c
     r.out = readBytes(outFile);
     r.err = readBytes(errFile);
     return r;
+}
+
+bool onPath(const std::string& program) {
+    return std::system(("command -v " + shellQuote(program) + " >/dev/null 2>&1").c_str()) == 0;
 }
 
 int countOccurrences(const std::string& hay, const std::string& needle) {

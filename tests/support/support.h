@@ -92,6 +92,14 @@ std::string shellQuote(const std::string& s);
 CliResult runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& captureDir,
                  int timeoutSeconds = 60);
 
+// Runs the shell command line `command` in `cwd` the same way (under
+// `timeout`, output captured in `captureDir`): for other tools (vdb_print, blender).
+CliResult runShell(const std::string& command, const std::string& cwd, const std::string& captureDir,
+                   int timeoutSeconds = 60);
+
+// True when `program` is an executable on PATH (tests of optional tools skip without it).
+bool onPath(const std::string& program);
+
 int countOccurrences(const std::string& hay, const std::string& needle);
 
 // ---------------------------------------------------------------------------
