@@ -39,8 +39,13 @@ struct MediumDesc {
     float densityScale = 1;
     bool hasEmission = false;
     std::string emissionGrid = "temperature";
-    float emissionScale = 1;
+    float emissionScale = 1;  // scale, or intensity with blackbody
     Color emissionColor{1, 1, 1};
+    // Blackbody mode: the grid maps to Kelvin as value x temperatureScale +
+    // temperatureOffset (active voxels only) and L_e = emissionScale x
+    // emissionColor x blackbodyRadiance(T) (core/blackbody.h).
+    bool blackbody = false;
+    float temperatureScale = 1, temperatureOffset = 0;
     Mat4 transform = Mat4::identity();
 };
 

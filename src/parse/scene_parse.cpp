@@ -199,11 +199,25 @@ MediumDesc parseMedium(const JsonReader& r, size_t index) {
         parseCoefficients(r, m);
         if (r.has("emission")) {
             JsonReader e = r.object("emission");
-            e.allowOnly({"grid", "scale", "color"});
+            e.allowOnly({"grid", "scale", "color", "blackbody", "intensity", "temperature_scale", "temperature_offset"});
             m.hasEmission = true;
             m.emissionGrid = e.string("grid", "temperature");
-            m.emissionScale = float(e.numberIn("scale", 1, 0, 1e30));
             m.emissionColor = e.nonNegativeColor("color", Vec3(1));
+            m.blackbody = e.boolean("blackbody", false);
+            // Each mode refuses the other's keys: "scale" of a temperature grid
+            // would be ambiguous (radiance or Kelvin?).
+            if (m.blackbody && e.has("scale"))
+                e.fail("scale", "is not used with blackbody emission: use intensity (radiance) or "
+                                "temperature_scale (grid value to Kelvin)");
+            for (const char* k : {"intensity", "temperature_scale", "temperature_offset"})
+                if (!m.blackbody && e.has(k)) e.fail(k, "is used only with \"blackbody\": true");
+            if (m.blackbody) {
+                m.emissionScale = float(e.numberIn("intensity", 1, 0, 1e30));
+                m.temperatureScale = float(e.numberIn("temperature_scale", 1, 0, 1e9));
+                m.temperatureOffset = float(e.numberIn("temperature_offset", 0, -1e9, 1e9));
+            } else {
+                m.emissionScale = float(e.numberIn("scale", 1, 0, 1e30));
+            }
         }
         m.transform = optionalTransform(r);
     }

@@ -59,7 +59,8 @@ public:
             float e = ctx.queries[size_t(src.medium)]->emission(p);
             if (!(rho > 0 && e > 0)) return;
             // Isotropic emission: 4 pi sigma_a rho L_e per unit volume.
-            ep.power = m.sigma_a * m.emissionColor * (4 * Pi * rho * e / pdf);
+            ep.power = m.blackbody ? m.sigma_a * m.emitted(e) * (4 * Pi * rho / pdf)
+                                   : m.sigma_a * m.emissionColor * (4 * Pi * rho * e / pdf);
             ep.ray = Ray{p, sampleUniformSphere(rng.uniform(), rng.uniform())};
         } else if (!src.emitter.sample(u, ep)) {
             return;
@@ -231,7 +232,8 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
         auto sampler = m.makeEmissionSampler();
         if (!sampler) continue;
         PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), false, false, 0, 0};
-        s.power = m.sigma_a * m.emissionColor * (4 * Pi * sampler->integralEstimate());
+        s.power = m.blackbody ? m.sigma_a * m.emissionColor * sampler->blackbodyIntegral() * (4 * Pi)
+                              : m.sigma_a * m.emissionColor * (4 * Pi * sampler->integralEstimate());
         s.volume = std::move(sampler);
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }

@@ -25,8 +25,10 @@ void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp) {
         mp.emission = Color(0);
         if (m.hasEmission) {
             const float e = ctx.queries[size_t(mi)]->emission(p);
-            if (e > 0)
-                for (int c = 0; c < 3; ++c) mp.emission[c] = mp.sigma_a[c] > 0 ? m.emissionColor[c] * e : 0.f;
+            if (e > 0) {
+                const Color le = m.emitted(e);
+                for (int c = 0; c < 3; ++c) mp.emission[c] = mp.sigma_a[c] > 0 ? le[c] : 0.f;
+            }
         }
         mp.phase.add(mp.sigma_s, m.g);
         return;
@@ -41,7 +43,8 @@ void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp) {
         mp.sigma_s += ss;
         if (m.hasEmission) {
             float e = ctx.queries[size_t(mi)]->emission(p);
-            if (e > 0) mp.emission += sa * m.emissionColor * e;  // normalised below
+            // Normalised below; the scalar mode keeps its order of products.
+            if (e > 0) mp.emission += m.blackbody ? sa * m.emitted(e) : sa * m.emissionColor * e;
         }
         mp.phase.add(ss, m.g);
     }

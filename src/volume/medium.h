@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/blackbody.h"
 #include "core/math.h"
 #include "parse/scene_desc.h"
 
@@ -25,7 +26,8 @@ public:
     virtual ~MediumQuery() = default;
     // Density (grid value x density_scale, sanitised >= 0) at a world point.
     virtual float density(const Vec3& p) = 0;
-    // scale x emission grid value at a world point (0 without emission).
+    // scale x emission grid value at a world point (0 without emission); with
+    // blackbody emission the temperature in Kelvin.
     virtual float emission(const Vec3& p) = 0;
     // Appends the parametric intervals of ray r within [tMin, tMax] where the
     // density may be non-zero, in increasing order. Everything outside them is
@@ -58,9 +60,12 @@ class EmissionSampler {
 public:
     virtual ~EmissionSampler() = default;
     virtual void sample(const float u[4], Vec3& p, float& pdf) const = 0;
-    // Approximate integral of density x emission over the grid (world
+    // Approximate integral of density x emission value over the grid (world
     // volume units), used to share photons between lights.
     virtual float integralEstimate() const = 0;
+    // Blackbody emission: the integral of density x blackbodyRadiance(T) per
+    // channel instead (the value, a temperature, is not a radiance).
+    virtual Color blackbodyIntegral() const { return Color(0); }
 };
 
 class Medium {
@@ -88,7 +93,15 @@ public:
     Color sigma_a, sigma_s;  // per world unit, per unit density
     float g = 0;
     bool hasEmission = false;
+    // L_e = emissionColor x emission(p); with blackbody emission
+    // L_e = emissionColor x blackbodyRadiance(emission(p)), the colour being
+    // the tint times the intensity.
     Color emissionColor{0, 0, 0};
+    bool blackbody = false;
+
+    // L_e for an emission value e > 0. The scalar product is the same
+    // operation per channel as emissionColor[c] * e.
+    Color emitted(float e) const { return blackbody ? emissionColor * blackbodyRadiance(e) : emissionColor * e; }
 };
 
 std::unique_ptr<Medium> makeHomogeneousMedium(const MediumDesc& desc);

@@ -116,6 +116,26 @@ std::string gridListing(openvdb::io::File& file) {
     return names.empty() ? "none" : names;
 }
 
+// Blackbody emission: active values become Kelvin, value x temperature_scale
+// + temperature_offset (inactive space stays 0 K: nothing emits there). A
+// negative temperature is refused, naming the value and the voxel.
+void toKelvin(openvdb::FloatGrid& grid, const MediumDesc& d, const std::string& what) {
+    // Beyond 1e9 K, sigma T^4 overflows a float: no flame is near it.
+    constexpr double MaxKelvin = 1e9;
+    for (auto it = grid.tree().beginValueOn(); it; ++it) {
+        const float v = *it;
+        if (!std::isfinite(v)) continue;  // sanitize() zeroes and counts these
+        const double k = double(v) * d.temperatureScale + d.temperatureOffset;
+        if (k < 0 || k > MaxKelvin)
+            throw InputError(str(what, ": value ", v, " at voxel ", it.getCoord(), " is ", k,
+                                 " K (emission.temperature_scale ", d.temperatureScale, ", temperature_offset ",
+                                 d.temperatureOffset, "): ",
+                                 k < 0 ? "a temperature in Kelvin cannot be negative"
+                                       : "above 1e9 K the blackbody radiance overflows"));
+        it.setValue(float(k));
+    }
+}
+
 // NaN, Inf and negative values become 0 (counted, one warning); inactive
 // values and the background become 0 so that "inactive" means "empty".
 void sanitize(openvdb::FloatGrid& grid, const std::string& what) {
@@ -374,12 +394,15 @@ public:
         if (d.hasEmission) {
             const std::string ewhat = str(d.file, ": emission grid '", d.emissionGrid, "'");
             mEmissionGrid = readFloatGrid(d.file, d.emissionGrid);
+            if (d.blackbody) toKelvin(*mEmissionGrid, d, ewhat);
             sanitize(*mEmissionGrid, ewhat);
             mEmissionI2W = indexToWorldMatrix(*mEmissionGrid, d.transform, ewhat);
             mEmissionW2I = Affine(mEmissionI2W.inverse(ewhat.c_str()));
-            mEmissionScale = d.emissionScale;
             hasEmission = d.emissionScale > 0 && !isBlack(d.emissionColor) && !isBlack(d.sigma_a);
-            emissionColor = d.emissionColor;
+            blackbody = d.blackbody;
+            // Blackbody: the grid holds Kelvin and the intensity goes into the colour.
+            mEmissionScale = blackbody ? 1.f : d.emissionScale;
+            emissionColor = blackbody ? d.emissionColor * d.emissionScale : d.emissionColor;
         }
     }
 
@@ -431,8 +454,10 @@ void VdbMedium::activeBoxes(std::vector<BBox>& out) const {
 }
 
 // Voxels of the emission grid, dilated by one (the trilinear stencil), each
-// weighted by the largest emission value its interpolation can see; a point
-// is drawn uniformly inside the chosen voxel's [c, c+1)^3 index cell.
+// weighted by the largest emission value its interpolation can see (with
+// blackbody emission the luminance at the largest temperature: it grows with
+// T, so it is positive wherever L_e can be); a point is drawn uniformly
+// inside the chosen voxel's [c, c+1)^3 index cell.
 class VdbEmissionSampler final : public EmissionSampler {
 public:
     explicit VdbEmissionSampler(const VdbMedium& m) : mI2W(m.mEmissionI2W) {
@@ -443,13 +468,14 @@ public:
         auto acc = grid.getConstAccessor();
         auto dens = m.mDensity->getConstAccessor();
         mVoxelVolume = float(std::fabs(mI2W.det3()));
-        double total = 0, estimate = 0;
+        double total = 0, estimate = 0, colour[3] = {0, 0, 0};
         for (auto it = topology.cbeginValueOn(); it; ++it) {
             openvdb::Coord c = it.getCoord();
             // The cell [c, c+1) interpolates the values at c + {0,1}^3.
             float w = 0;
             for (int i = 0; i < 8; ++i)
                 w = std::max(w, acc.getValue(c.offsetBy(i & 1, (i >> 1) & 1, (i >> 2) & 1)));
+            if (m.blackbody) w = blackbodyLuminance(w);
             if (!(w > 0)) continue;
             total += w;
             mCoords.push_back(c);
@@ -458,10 +484,16 @@ public:
             openvdb::Vec3d centre(c.x() + 0.5, c.y() + 0.5, c.z() + 0.5);
             Vec3 wc = mI2W.point(centre.x(), centre.y(), centre.z());
             float rho = sampleTrilinear(dens, m.mW2I.point(wc)) * m.mScale;
-            estimate += double(rho) * sampleTrilinear(acc, centre);
+            const float e = sampleTrilinear(acc, centre);
+            estimate += double(rho) * e;
+            if (m.blackbody) {
+                const Color le = blackbodyRadiance(e);
+                for (int k = 0; k < 3; ++k) colour[k] += double(rho) * le[k];
+            }
         }
         for (double& v : mCdf) v /= total;
         mIntegral = float(estimate * mVoxelVolume * m.mEmissionScale);
+        for (int k = 0; k < 3; ++k) mColourIntegral[k] = float(colour[k] * mVoxelVolume);
         for (size_t i = 0; i < mCdf.size(); ++i) mWeights.push_back(float((i ? mCdf[i] - mCdf[i - 1] : mCdf[i])));
     }
 
@@ -476,9 +508,11 @@ public:
     }
 
     float integralEstimate() const override { return mIntegral; }
+    Color blackbodyIntegral() const override { return mColourIntegral; }
 
 private:
     Mat4 mI2W;
+    Color mColourIntegral{0, 0, 0};
     std::vector<openvdb::Coord> mCoords;
     std::vector<double> mCdf;
     std::vector<float> mWeights;

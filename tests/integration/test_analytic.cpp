@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "core/blackbody.h"
 #include "core/sampling.h"
 #include "support/support.h"
 
@@ -70,6 +71,27 @@ TEST(AnalyticMarcher, EmissionOfAbsorbingBoxIsExact) {
             ASSERT_NEAR(c.y, k * 0.5, 2e-5);
             ASSERT_NEAR(c.z, k * 0.25, 2e-5);
         }
+}
+
+// The same box with blackbody emission: the temperature grid (1) scaled to
+// 2500 K, so L = intensity x tint x blackbodyRadiance(2500 K) x (1 - exp(-sigma_a)),
+// the colour from the exact Planck sum (the table lookup is within 3e-5 of
+// it in luminance-1 units: tests/core/test_blackbody.cpp).
+TEST(AnalyticMarcher, BlackbodyEmissionOfAbsorbingBoxIsExact) {
+    TempDir dir;
+    std::string vdb = writeEmissiveBox(dir / "blackbody.vdb");
+    auto scene = sceneFromJson("{" + orthoCamera(0.5f, 8) + R"(,
+        "media": [{"type": "vdb", "file": ")" + vdb + R"(", "sigma_a": [1.5, 1.5, 1.5], "sigma_s": 0,
+                   "emission": {"grid": "temperature", "blackbody": true, "temperature_scale": 2500,
+                                "intensity": 2, "color": [1, 0.5, 1]}}],
+        "render": {"seed": 2, "spp": 2}})");
+    RenderResult r = renderImage(*scene);
+    const double k = 2 * blackbodyLuminance(2500) * (1 - std::exp(-1.5));
+    const Color c = blackbodyColorExact(2500);
+    const double expected[3] = {k * c.x, k * 0.5 * c.y, k * c.z};
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x)
+            for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(r.image.rgb(x, y)[ch], expected[ch], 2e-5 + 3e-5 * k) << ch;
 }
 
 // Single scattering in a slab of thickness d lit by a directional light at

@@ -4,11 +4,13 @@
 // against the reference path tracer on a heterogeneous VDB cloud.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <tuple>
 
+#include "core/blackbody.h"
 #include "core/error.h"
 #include "marchers/marcher.h"
 #include "illumination/illumination.h"
@@ -28,33 +30,64 @@ using namespace test;
 // max_depth 64 leaves 0.5^64 of the multiple scattering out.
 class EmissiveFurnace : public ::testing::TestWithParam<std::tuple<Method, LiSource>> {};
 
-TEST_P(EmissiveFurnace, EveryPixelIsOne) {
-    const auto [method, li] = GetParam();
+// Per channel (and, last, the channels' average): the mean pixel of each of 8
+// independent renders (pixel and photon seeds). The pixels of one render
+// share its photon map, whose error is common to all of them, so the
+// standard error comes from the spread of whole renders.
+std::array<SampleStats, 4> furnaceRenders(Method method, LiSource li, const std::string& emission) {
     TempDir dir("furnace");
     const std::string vdb = writeEmissiveBox(dir / "furnace.vdb", -20, 20, 4, 1.0);
-    // Independent renders (pixel and photon seeds): the pixels of one render
-    // share its photon map, whose error is common to all of them, so the
-    // standard error comes from the spread of whole renders.
-    SampleStats renders;
+    std::array<SampleStats, 4> renders;
     for (int run = 0; run < 8; ++run) {
         auto scene = sceneFromJson(str(R"({
             "camera": {"position": [0.3, 0.2, 0.1], "look_at": [1, 0.5, -2], "fov_deg": 90, "resolution": [12, 9]},
             "media": [{"type": "vdb", "file": ")", vdb, R"(", "sigma_a": 1, "sigma_s": 1, "g": 0.7,
-                       "emission": {"grid": "temperature", "scale": 1}}],
+                       "emission": )", emission, R"(}],
             "photons": {"count": 100000, "k": 100},
             "render": {"max_depth": 64, "seed": )", 100 + run, R"(, "spp": )", method == Method::Reference ? 16 : 4,
                                        R"(, "li": ")", liSourceName(li), R"("}})"));
         scene->desc.render.method = method;
         RenderResult r = renderImage(*scene);
-        SampleStats pixels;
+        std::array<SampleStats, 4> pixels;
         for (int y = 0; y < r.image.height; ++y)
-            for (int x = 0; x < r.image.width; ++x) pixels.add(average(r.image.rgb(x, y)));
-        renders.add(pixels.mean());
+            for (int x = 0; x < r.image.width; ++x) {
+                const Color c = r.image.rgb(x, y);
+                for (int ch = 0; ch < 3; ++ch) pixels[size_t(ch)].add(c[ch]);
+                pixels[3].add(average(c));
+            }
+        for (size_t ch = 0; ch < 4; ++ch) renders[ch].add(pixels[ch].mean());
     }
+    return renders;
+}
+
+TEST_P(EmissiveFurnace, EveryPixelIsOne) {
+    const auto [method, li] = GetParam();
+    const SampleStats renders = furnaceRenders(method, li, R"({"grid": "temperature", "scale": 1})")[3];
     if (std::getenv("VDBMARCH_VERBOSE"))
         std::printf("furnace %s li=%s: mean %.5f, SE %.2g\n", methodName(method), liSourceName(li), renders.mean(),
                     renders.stdError());
     EXPECT_NEAR(renders.mean(), 1.0, 4 * renders.stdError()) << methodName(method) << " li=" << liSourceName(li);
+}
+
+// The same furnace glowing as a 3000 K blackbody: every pixel is
+// L_e = blackbodyRadiance(3000 K) (luminance 1.46) in each channel. With li = photons the
+// emitted photons carry that colour (the sampler weights voxels by the
+// blackbody luminance, the power per channel by the radiance).
+class BlackbodyFurnace : public EmissiveFurnace {};
+
+TEST_P(BlackbodyFurnace, PixelsAreTheBlackbodyRadiance) {
+    const auto [method, li] = GetParam();
+    const auto renders =
+        furnaceRenders(method, li, R"({"grid": "temperature", "blackbody": true, "temperature_scale": 3000})");
+    const Color expected = blackbodyRadiance(3000);
+    for (int ch = 0; ch < 3; ++ch) {
+        const SampleStats& s = renders[size_t(ch)];
+        if (std::getenv("VDBMARCH_VERBOSE"))
+            std::printf("blackbody furnace %s li=%s channel %d: mean %.5f (expected %.5f), SE %.2g\n",
+                        methodName(method), liSourceName(li), ch, s.mean(), expected[ch], s.stdError());
+        EXPECT_NEAR(s.mean(), expected[ch], 4 * s.stdError()) << methodName(method) << " li=" << liSourceName(li)
+                                                               << " channel " << ch;
+    }
 }
 
 std::string furnaceName(const ::testing::TestParamInfo<std::tuple<Method, LiSource>>& info) {
@@ -70,6 +103,17 @@ std::vector<std::tuple<Method, LiSource>> furnaceCases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, EmissiveFurnace, ::testing::ValuesIn(furnaceCases()), furnaceName);
+
+// The photon cases, where the blackbody colour travels as photon power, and
+// the reference path tracer.
+std::vector<std::tuple<Method, LiSource>> blackbodyFurnaceCases() {
+    std::vector<std::tuple<Method, LiSource>> cases;
+    for (const auto& c : furnaceCases())
+        if (std::get<0>(c) == Method::Reference || std::get<1>(c) == LiSource::Photons) cases.push_back(c);
+    return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, BlackbodyFurnace, ::testing::ValuesIn(blackbodyFurnaceCases()), furnaceName);
 
 // The continuation estimate of L_i is unbiased: every marcher with
 // render.li = "path" agrees with the reference path tracer on the VDB cloud

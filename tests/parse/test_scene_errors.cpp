@@ -127,6 +127,35 @@ TEST_F(BadInput, NegativeScalarSigmaAOnVdbMedium) {
     EXPECT_TRUE(hasNumberToken(msg, "-3")) << msg;
 }
 
+// Blackbody emission keys: each mode refuses the other's keys, values are
+// range-checked, all naming the key path and the value.
+TEST_F(BadInput, BlackbodyEmissionKeysAreChecked) {
+    auto error = [&](const std::string& emission) {
+        std::string text = vdbScene("density");
+        size_t p = text.find("\"sigma_a\": 0.5");
+        EXPECT_NE(p, std::string::npos);
+        text.insert(p, "\"emission\": " + emission + ", ");
+        return errorOf<InputError>([&] { parseSceneText(text, "bb.json"); });
+    };
+    std::string msg = error(R"({"blackbody": true, "scale": 3})");
+    EXPECT_CONTAINS(msg, "bb.json");
+    EXPECT_CONTAINS(msg, "media[0].emission.scale");
+    EXPECT_CONTAINS(msg, "intensity");
+    msg = error(R"({"intensity": 2})");
+    EXPECT_CONTAINS(msg, "media[0].emission.intensity");
+    EXPECT_CONTAINS(msg, "blackbody");
+    msg = error(R"({"blackbody": true, "temperature_scale": -1})");
+    EXPECT_CONTAINS(msg, "media[0].emission.temperature_scale");
+    EXPECT_TRUE(hasNumberToken(msg, "-1")) << msg;
+    msg = error(R"({"blackbody": true, "intensity": -0.5})");
+    EXPECT_CONTAINS(msg, "media[0].emission.intensity");
+    EXPECT_TRUE(hasNumberToken(msg, "-0.5")) << msg;
+    msg = error(R"({"blackbody": "yes"})");
+    EXPECT_CONTAINS(msg, "media[0].emission.blackbody");
+    msg = error(R"({"blackbody": true, "temperature_ofset": 3})");
+    EXPECT_CONTAINS(msg, "temperature_offset");
+}
+
 // Found by fuzzing (tools/fuzz.sh, fuzz_scene_json): a number too large for
 // a double is nlohmann's out_of_range, not a parse_error, and escaped the
 // parser without the file's name.

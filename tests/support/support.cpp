@@ -310,6 +310,16 @@ std::string writeEmissiveBox(const std::string& path, const Index3& lo, const In
     return path;
 }
 
+std::string writeTemperatureRamp(const std::string& path, const Index3& lo, const Index3& hi, int margin, double h,
+                                 float t0, float dt) {
+    auto temperature = boxGrid(Index3(lo.x - margin, lo.y - margin, lo.z - margin),
+                               Index3(hi.x + margin, hi.y + margin, hi.z + margin), 1.f, h, "temperature");
+    for (auto it = temperature->tree().beginValueOn(); it; ++it)
+        it.setValue(t0 + dt * float(it.getCoord().x() - lo.x + margin));
+    writeGrids(path, {boxGrid(lo, hi, 1.f, h, "density"), temperature});
+    return path;
+}
+
 void writeVdbFixtures(const std::string& dir) {
     initOpenVdb();
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();

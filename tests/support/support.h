@@ -244,6 +244,11 @@ std::string writeEmissiveBox(const std::string& path);
 // `margin` voxels larger on every side.
 std::string writeEmissiveBox(const std::string& path, const Index3& lo, const Index3& hi, int margin, double h);
 
+// The same with a temperature rising along x: t0 + dt x (i - lo.x + margin)
+// at index (i, j, k) of the temperature box.
+std::string writeTemperatureRamp(const std::string& path, const Index3& lo, const Index3& hi, int margin, double h,
+                                 float t0, float dt);
+
 // Fixture geometry of writeVdbFixtures: voxel size 0.25, a 4x4x4 block of
 // voxels at index [-2, 1]^3, i.e. a cube of world edge 1 centred near the origin.
 constexpr double kVoxel = 0.25;

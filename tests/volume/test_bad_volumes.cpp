@@ -92,6 +92,68 @@ TEST_F(BadInput, UnknownEmissionGridListsTheGridsThatExist) {
     EXPECT_CONTAINS(msg, "'density'");
 }
 
+// Blackbody emission: a missing temperature grid and temperatures below 0 K
+// (in the file, or after temperature_scale / temperature_offset) are refused
+// naming the file, the grid and the value; the command writes nothing.
+std::string withEmission(const std::string& emission) {
+    std::string text = vdbScene("density");
+    size_t p = text.find("\"sigma_s\": 2");
+    EXPECT_NE(p, std::string::npos);
+    text.insert(p, "\"emission\": " + emission + ", ");
+    return text;
+}
+
+// The InputError message of building the fixture scene with `emission`.
+std::string buildError(const std::string& workScene, const std::string& emission) {
+    SceneDesc desc = parseSceneText(withEmission(emission), workScene);
+    return errorOf<InputError>([&] { buildScene(desc); });
+}
+
+TEST_F(BadInput, MissingBlackbodyTemperatureGridNamesFileAndGrid) {
+    const std::string msg = buildError(work("scene.json"), R"({"grid": "temprature", "blackbody": true})");
+    EXPECT_CONTAINS(msg, work("grids.vdb"));
+    EXPECT_CONTAINS(msg, "'temprature'");
+    EXPECT_CONTAINS(msg, "'density'");
+}
+
+TEST_F(BadInput, NegativeBlackbodyTemperatureNamesFileGridAndValue) {
+    // Grid "bad" holds -0.5 and -3 among its good values (and NaN / Inf,
+    // which are zeroed with a warning as for density).
+    std::string msg = buildError(work("scene.json"), R"({"grid": "bad", "blackbody": true})");
+    EXPECT_CONTAINS(msg, work("grids.vdb"));
+    EXPECT_CONTAINS(msg, "emission grid 'bad'");
+    EXPECT_CONTAINS(msg, "cannot be negative");
+    EXPECT_TRUE(hasNumberToken(msg, "-0.5") || hasNumberToken(msg, "-3")) << msg;
+
+    // Values of 1 mapped by the offset to -1 K: the message gives the mapping.
+    const std::string offset = R"({"grid": "density", "blackbody": true, "temperature_offset": -2})";
+    writeText(work("scene.json"), withEmission(offset));
+    msg = buildError(work("scene.json"), offset);
+    EXPECT_CONTAINS(msg, "emission grid 'density'");
+    EXPECT_CONTAINS(msg, "temperature_offset -2");
+    EXPECT_TRUE(hasNumberToken(msg, "-1")) << msg;
+
+    CliResult r = cli({"render", "scene.json", "-o", "out.exr"});
+    expectCliError(r, {"grids.vdb", "'density'", "cannot be negative"});
+    EXPECT_FALSE(fs::exists(work("out.exr")));
+}
+
+// A grid in Kelvin renders; the same values scaled into Kelvin render the same.
+TEST_F(BadInput, BlackbodyTemperatureScaleMapsGridToKelvin) {
+    auto render = [&](const std::string& emission) {
+        SceneDesc desc = parseSceneText(withEmission(emission), work("scene.json"));
+        return renderImage(*buildScene(desc)).image;
+    };
+    const Image a = render(R"({"grid": "density", "blackbody": true, "temperature_scale": 2000})");
+    const Image b = render(R"({"grid": "density", "blackbody": true, "temperature_scale": 1000, "temperature_offset": 1000})");
+    EXPECT_EQ(a.rgba, b.rgba);
+    const Image off = render(R"({"grid": "density", "blackbody": true, "temperature_scale": 0})");
+    bool brighter = false;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) brighter = brighter || a.rgb(x, y).x > off.rgb(x, y).x;
+    EXPECT_TRUE(brighter) << "2000 K emission adds light";
+}
+
 // ===========================================================================
 // 4. A vector grid where a float grid is needed
 
