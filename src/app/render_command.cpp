@@ -22,7 +22,8 @@ namespace vdbmarch {
 
 const SceneOptionTable<RenderArgs>& renderSceneOptions() {
     static const SceneOptionTable<RenderArgs> table = {
-        {"--method", "render.method", "Estimator: " + methodList(), &RenderArgs::method},
+        {"--method", "render.method", "Estimator: auto (the default: chosen from what the scene contains), " + methodList(),
+         &RenderArgs::method},
         {"--spp", "render.spp", "Samples per pixel", &RenderArgs::spp},
         {"--seed", "render.seed", "Random seed", &RenderArgs::seed},
         {"--threads", "render.threads", "Worker threads (0 = all cores)", &RenderArgs::threads},
@@ -42,6 +43,11 @@ const SceneOptionTable<RenderArgs>& renderSceneOptions() {
 }
 
 namespace {
+
+// "guided", or "reference (auto: multiple scattering in open media)".
+std::string methodLabel(const RenderSettings& r) {
+    return r.methodAuto ? str(methodName(r.method), " (auto: ", r.methodReason, ")") : std::string(methodName(r.method));
+}
 
 // Refuses bad option values and unwritable outputs before anything is loaded.
 void validate(const RenderArgs& a) {
@@ -79,6 +85,7 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     s["cache_cells"] = r.cacheCells;
     s["threads"] = r.threads;
     s["method"] = methodName(desc.render.method);
+    s["method_auto"] = desc.render.methodAuto;
     s["spp"] = r.spp;
     if (a.timeBudget) s["time_budget"] = *a.timeBudget;
     s["resolution"] = {r.image.width, r.image.height};
@@ -127,7 +134,7 @@ int runRender(const RenderArgs& a) {
     StringAttributes attrs = {
         {"vdbmarch:version", VDBMARCH_VERSION},
         {"vdbmarch:source", desc.file},
-        {"vdbmarch:method", methodName(desc.render.method)},
+        {"vdbmarch:method", methodLabel(desc.render)},
         {"vdbmarch:spp", std::to_string(r.spp)},
         {"vdbmarch:photonPasses", std::to_string(r.photonPasses)},
         {"vdbmarch:timeBudget", a.timeBudget ? str(*a.timeBudget) : std::string("none")},
@@ -144,7 +151,7 @@ int runRender(const RenderArgs& a) {
     if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total));
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
-                     r.image.width, r.image.height, r.spp, methodName(desc.render.method), double(scene->step),
+                     r.image.width, r.image.height, r.spp, methodLabel(desc.render).c_str(), double(scene->step),
                      r.seconds,
                      r.illuminationSeconds > 0
                          ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s in ",

@@ -67,6 +67,10 @@ struct SurfaceDesc {
 
 struct RenderSettings {
     Method method = Method::Uniform;
+    // render.method = "auto" (the default): `method` is chosen from what the
+    // scene contains (parse/auto_method.h), `methodReason` says why.
+    bool methodAuto = true;
+    std::string methodReason;
     int spp = 1;
     float step = 0;        // world units; 0 = automatic
     float shadowStep = 0;  // 0 = same as step

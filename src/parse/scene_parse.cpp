@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "parse/scene_json.h"
+#include "parse/auto_method.h"
 #include "parse/json_locate.h"
 #include "parse/json_reader.h"
 #include "parse/scene_desc.h"
@@ -277,9 +278,11 @@ RenderSettings parseRender(const JsonReader& r) {
                  "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling"});
     RenderSettings s;
     {
-        std::vector<std::string> names;
+        std::vector<std::string> names = {"auto"};
         for (Method m : allMethods()) names.push_back(methodName(m));
-        parseMethod(r.choice("method", methodName(s.method), names), s.method);
+        const std::string name = r.choice("method", "auto", names);
+        s.methodAuto = name == "auto";
+        if (!s.methodAuto) parseMethod(name, s.method);
     }
     s.spp = r.integer("spp", s.spp, 1, 1 << 24);
     if (r.has("step")) s.step = float(r.positive("step", 1));
@@ -427,6 +430,7 @@ SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
     if (root.has("render")) scene.render = parseRender(root.object("render"));
     if (root.has("photons")) scene.photons = parsePhotons(root.object("photons"));
     if (root.has("cache")) scene.cache = parseCache(root.object("cache"));
+    if (scene.render.methodAuto) scene.render.method = chooseMethod(scene, scene.render.methodReason);
     return scene;
 }
 

@@ -183,7 +183,8 @@ TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
         auto scene = sceneFromJson(R"({"camera": {"type": "perspective", "position": [0.5, 0.4, 3], "look_at": [0.225, 0.225, 0.225],
             "fov_deg": 20, "resolution": [24, 24]},
             "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}],
-            "media": [{"type": "vdb", "file": ")" + file + R"(", "sigma_s": 4}]})");
+            "media": [{"type": "vdb", "file": ")" + file + R"(", "sigma_s": 4}],
+            "render": {"method": "uniform"}})");  // deterministic march: counts compare exactly
         return renderImage(*scene).counters;
     };
     RenderCounters a = run(small), b = run(large);
