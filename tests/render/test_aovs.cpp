@@ -196,6 +196,36 @@ TEST(AovFeatures, PerspectiveDepthIsViewAxisDistance) {
     }
 }
 
+// Glass is a surface for depth, but albedo follows it to the first diffuse
+// event (OpenImageDenoise's advice for delta surfaces): through a glass slab
+// (ior 1.5) at normal incidence a sample reaches the wall behind with the
+// slab's transmittance (1 - R)^2 / (1 - R^2), R = 0.04, and Fresnel choices
+// weigh 1, so the albedo is 0.5 times that (binomial standard error).
+TEST(AovFeatures, AlbedoFollowsGlassDepthStopsAtIt) {
+    const int spp = 64, pixels = 16;
+    auto scene = sceneFromJson(R"({
+      "camera": {"type": "orthographic", "position": [0, 0, 3], "look_at": [0, 0, 0], "width_world": 1,
+                 "resolution": [4, 4]},
+      "surfaces": [
+        {"shape": "box", "transform": {"scale": [4, 4, 1]}, "material": {"type": "dielectric", "ior": 1.5}},
+        {"shape": "box", "transform": {"scale": [8, 8, 1], "translate": [0, 0, -2.5]},
+         "material": {"type": "diffuse", "albedo": 0.5}}],
+      "render": {"spp": 64, "pixel_jitter": false, "aovs": ["depth", "albedo", "normal"]}
+    })");
+    const RenderResult r = renderImage(*scene);
+    ASSERT_EQ(r.layers.size(), 3u);
+    const double R = 0.04, T = (1 - R) * (1 - R) / (1 - R * R);
+    const double sigma = 0.5 * std::sqrt(T * (1 - T) / (spp * pixels));
+    double albedo = 0;
+    for (size_t p = 0; p < r.image.pixelCount(); ++p) {
+        EXPECT_NEAR(r.layers[0].pixels[p], 2.5f, 1e-5f);
+        albedo += r.layers[1].pixels[3 * p] / double(pixels);
+        EXPECT_EQ(r.layers[1].pixels[3 * p], r.layers[1].pixels[3 * p + 2]);  // grey
+    }
+    RecordProperty("albedo", str(albedo, " expected ", 0.5 * T, " sigma ", sigma));
+    EXPECT_NEAR(albedo, 0.5 * T, 4 * sigma);
+}
+
 // Layers are written into the beauty's single-part EXR under the names a
 // compositor groups ("depth.Z", "albedo.R", ...), read back by OpenEXR;
 // readExr still reads the beauty.
