@@ -36,6 +36,9 @@ const SceneOptionTable<RenderArgs>& renderSceneOptions() {
          &RenderArgs::li},
         {"--ray-samples", "render.ray_samples",
          "L_i samples per ray segment for transmittance and guided (render.ray_samples)", &RenderArgs::raySamples},
+        {"--aovs", "render.aovs",
+         "Extra EXR layers, comma-separated: depth, albedo, normal, direct, indirect (docs/aovs.md)",
+         &RenderArgs::aovs},
         {"--sh-order", "cache.sh_order", "SH order of the cache built for guided; 0 = scalar cache (cache.sh_order)",
          &RenderArgs::shOrder},
     };
@@ -115,7 +118,7 @@ int runRender(const RenderArgs& a) {
 
     if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
     SceneDesc desc = loadSceneInput(a.input, overrides);
-    checkImageMemory(desc.camera.width, desc.camera.height);  // before any volume is loaded
+    checkImageMemory(desc.camera.width, desc.camera.height, desc.render.aovs);  // before any volume is loaded
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -144,7 +147,7 @@ int runRender(const RenderArgs& a) {
         {"vdbmarch:renderSeconds", str(r.seconds)},
         {"vdbmarch:scene", desc.jsonText},
     };
-    writeExr(a.output, r.image, attrs);
+    writeExr(a.output, r.image, attrs, r.layers);
     if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
     if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

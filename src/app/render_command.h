@@ -16,7 +16,7 @@ struct RenderArgs {
     std::optional<double> timeBudget;  // --time
     std::vector<std::string> sets;     // --set key.path=value
     // Scene overrides (renderSceneOptions); unset ones keep the scene's values.
-    std::string method, li;
+    std::string method, li, aovs;
     std::optional<int> spp, threads, raySamples, shOrder;
     std::optional<long long> seed;
     std::optional<double> step, exposure;

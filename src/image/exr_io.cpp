@@ -113,7 +113,8 @@ auto withInputFile(const std::string& path, Fn fn) -> decltype(fn(std::declval<I
 
 }  // namespace
 
-void writeExr(const std::string& path, const Image& img, const StringAttributes& attributes) {
+void writeExr(const std::string& path, const Image& img, const StringAttributes& attributes,
+              const std::vector<ExrLayer>& layers) {
     if (img.empty()) throw InputError(str("cannot write '", path, "': image is empty"));
     if (img.rgba.size() != img.pixelCount() * 4)
         throw InputError(str("cannot write '", path, "': pixel buffer does not match ", img.width,
@@ -137,6 +138,22 @@ void writeExr(const std::string& path, const Image& img, const StringAttributes&
     Imf::FrameBuffer fb;
     for (int c = 0; c < 4; ++c)
         fb.insert(RgbaNames[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xStride, yStride));
+
+    for (const ExrLayer& layer : layers) {
+        const size_t n = layer.channels.size();
+        if (layer.name.empty() || n == 0 || layer.pixels.size() != img.pixelCount() * n)
+            throw InputError(str("cannot write '", path, "': layer '", layer.name, "' does not hold ", n,
+                                 " channel(s) of ", img.width, "x", img.height, " pixels"));
+        for (size_t c = 0; c < n; ++c) {
+            const std::string name = layer.name + "." + layer.channels[c];
+            if (header.channels().findChannel(name))
+                throw InputError(str("cannot write '", path, "': duplicate channel '", name, "'"));
+            header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+            char* layerBase = reinterpret_cast<char*>(const_cast<float*>(layer.pixels.data()));
+            fb.insert(name, Imf::Slice(Imf::FLOAT, layerBase + c * sizeof(float), n * sizeof(float),
+                                       n * sizeof(float) * size_t(img.width)));
+        }
+    }
 
     AtomicFile file(path);
     try {

@@ -19,6 +19,10 @@ struct Illumination;
 struct PathResult {
     Color L;              // radiance towards the camera
     float transmittance;  // fraction of the background seen (alpha = 1 - this)
+    // The part of L after at most one scattering event (emission and
+    // unscattered light included): filled only when render.aovs asks for
+    // "direct" or "indirect" (docs/aovs.md), else zero.
+    Color direct{0};
 };
 
 class Marcher {

@@ -21,12 +21,13 @@ public:
         const int region = regionAtRayStart(mScene, cameraRay);
         if (!mChromatic) {
             PathRadiance p = tracePath(ctx, cameraRay, region, -1, rng, {});
-            return {p.L, p.transmittance};
+            return {p.L, p.transmittance, p.direct};
         }
         PathResult out{Color(0), 0.f};
         for (int c = 0; c < 3; ++c) {
             PathRadiance p = tracePath(ctx, cameraRay, region, c, rng, {});
             out.L[c] = p.L[c];
+            out.direct[c] = p.direct[c];
             out.transmittance += p.transmittance / 3;
         }
         return out;

@@ -128,7 +128,10 @@ private:
                     if (isBlack(mp.sigma_t)) continue;
                     const float len = float(b - a);
                     const StepTerms st = stepTerms(mp, len);
-                    if (!isBlack(mp.emission)) L += beta * T * st.absorbedA * mp.emission;
+                    if (!isBlack(mp.emission)) {
+                        L += beta * T * st.absorbedA * mp.emission;
+                        if (mTallyDirect) tallyEmission(ctx, beta * T * st.absorbedA * mp.emission);
+                    }
                     const float base = mp.scatters() ? average(T * st.absorbedS) : 0.f;  // sigma_s T(t0) S(kappa, len)
                     if (base > 0) {
                         steps.push_back({float(a), len, average(mp.sigma_t), base});
@@ -177,7 +180,9 @@ private:
                     if (isBlack(Li)) continue;
                     Color Tt = m.stepT[size_t(k)];
                     for (int c = 0; c < 3; ++c) Tt[c] *= std::exp(-m.stepKappa[size_t(k)][c] * offset);
-                    L += beta * Tt * m.stepSigmaS[size_t(k)] * Li * float(1.0 / (double(n) * p));
+                    const Color weight = beta * Tt * m.stepSigmaS[size_t(k)];
+                    L += weight * Li * float(1.0 / (double(n) * p));
+                    if (mTallyDirect) tallyInScattered(ctx, weight * float(1.0 / (double(n) * p)));
                 }
             }
         }

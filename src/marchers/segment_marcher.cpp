@@ -11,7 +11,8 @@
 namespace vdbmarch {
 
 SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination)
-    : mScene(scene), mIllumination(std::move(illumination)), mChromatic(hasChromaticExtinction(scene)) {
+    : mScene(scene), mIllumination(std::move(illumination)), mChromatic(hasChromaticExtinction(scene)),
+      mTallyDirect(scene.desc.render.aovs.splitDirect()) {
     // Without emissive media or refracting glass, the light arriving at a
     // sample straight from its first direction is what next-event estimation
     // samples (lights and the background).
@@ -24,6 +25,18 @@ SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumin
 }
 
 PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
+    if (!mTallyDirect) return trace(cameraRay, rng, ctx);
+    scratch(ctx).direct = Color(0);
+    PathResult r = trace(cameraRay, rng, ctx);
+    r.direct = scratch(ctx).direct;
+    return r;
+}
+
+// Scattering orders of the contributions (the direct AOV): lights and the
+// background seen after at most one diffuse bounce, emission before the
+// second, a surface's next-event estimate at the first bounce, and what
+// inScattered() counts as direct at a march sample before the first bounce.
+PathResult SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
     const Scene& scene = mScene;
     ++ctx.counters.cameraRays;
     Color L(0), beta(1);
@@ -41,12 +54,16 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
         float segEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
         scratch(ctx).pathDepth = diffuseBounces;
         if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f};
+        auto addSeen = [&](const Color& Le) {
+            L += Le;
+            if (mTallyDirect && diffuseBounces <= 1) scratch(ctx).direct += Le;
+        };
         if (light >= 0) {
-            if (!lightsCounted) L += beta * scene.lights[size_t(light)].emittedRadiance();
+            if (!lightsCounted) addSeen(beta * scene.lights[size_t(light)].emittedRadiance());
             return {L, 0.f};
         }
         if (!hit) {
-            if (!lightsCounted) L += beta * scene.environment.radiance(ray.d);
+            if (!lightsCounted) addSeen(beta * scene.environment.radiance(ray.d));
             return {L, diffuseBounces > 0 ? 0.f : average(beta)};  // a diffuse surface is opaque
         }
         ++ctx.counters.surfaceHits;
@@ -55,7 +72,9 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
         const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            L += beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, {});
+            const Color Ld = beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, {});
+            L += Ld;
+            if (mTallyDirect && diffuseBounces == 0) scratch(ctx).direct += Ld;
             // Light that reaches the surface after scattering in a medium
             // (what shadow rays miss): continue the path in the cosine-
             // sampled direction, marching the media it crosses, as a
@@ -96,6 +115,11 @@ bool SegmentMarcher::buildProductSampler(ThreadContext& ctx, const Vec3& x, cons
 
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
                                   const MediumPoint& mp, Rng& rng, float pathProbability) const {
+    // The direct AOV: light scattered here once, when this is the camera
+    // path's first event; photons and the cache count as indirect.
+    MarcherScratch& m = scratch(ctx);
+    if (mTallyDirect) m.liDirect = Color(0);
+    const bool tallyHere = mTallyDirect && m.pathDepth == 0;
     if (!mp.scatters()) return Color(0);
     ++ctx.counters.liSamples;
     const Illumination& il = *mIllumination;
@@ -113,18 +137,22 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         return il.indirect->estimateLi(x, -rayDir, size_t(il.k), [&](float c) { return mp.phase.eval(c); }, nullptr,
                                        il.radiusScale);
     };
-    if (il.li == LiSource::Photons) return directLight(ctx, region, vertex, rng, {}) + photons();
+    auto direct = [&](const Color& Ld) {
+        if (tallyHere) m.liDirect = Ld;
+        return Ld;
+    };
+    if (il.li == LiSource::Photons) return direct(directLight(ctx, region, vertex, rng, {})) + photons();
     // A continuation path: next-event estimation here (weighed by MIS
     // against the path's own sphere-light hits), then a phase-sampled
     // direction followed by the path tracer from this vertex. Unbiased for
     // all the light a path can reach; the caustic photons add the rest.
-    const int depth = scratch(ctx).pathDepth + 1;  // this sample's scattering event
+    const int depth = m.pathDepth + 1;  // this sample's scattering event
     if (depth >= mScene.desc.render.maxDepth && mLastEventByNextEvent) {
         // The last event max_depth allows: a path from here could only find
         // lights and the background straight along its first direction,
         // which next-event estimation samples directly (no path needed).
         static constexpr DirectLightOptions kLastEvent{TransmittanceEstimator::RatioTracking, false, true};
-        return directLight(ctx, region, vertex, rng, kLastEvent) + photons();
+        return direct(directLight(ctx, region, vertex, rng, kLastEvent)) + photons();
     }
     static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
     // The continuation's direction: phase x cached radiance where the cache
@@ -133,13 +161,13 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     ScatterVertex nextEventVertex = vertex;
     const ProductDirectionSampler* product = nullptr;
     if (mProductSampling && buildProductSampler(ctx, x, rayDir, mp)) {
-        product = &scratch(ctx).productSampler;
+        product = &m.productSampler;
         nextEventVertex.pathSampler = product;
         nextEventVertex.pathPdf = [](const void* s, const Vec3& wi) {
             return static_cast<const ProductDirectionSampler*>(s)->pdf(wi);
         };
     }
-    Color Li = directLight(ctx, region, nextEventVertex, rng, kNextEvent);
+    Color Li = direct(directLight(ctx, region, nextEventVertex, rng, kNextEvent));
     const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
     if (tracePathHere) {
@@ -156,10 +184,14 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         }
         const PathState state{depth, false, pdf, x, il.pointLightsByPhotons};
         if (pdf > 0 && !mChromatic) {
-            Li += weight * tracePath(ctx, Ray{x, wi}, region, -1, rng, state).L;
+            const PathRadiance p = tracePath(ctx, Ray{x, wi}, region, -1, rng, state);
+            Li += weight * p.L;
+            if (tallyHere) m.liDirect += weight * p.direct;
         } else if (pdf > 0) {  // one channel, picked uniformly: 3 times its radiance
             const int c = std::min(2, int(rng.uniform() * 3));
-            Li[c] += 3 * weight[c] * tracePath(ctx, Ray{x, wi}, region, c, rng, state).L[c];
+            const PathRadiance p = tracePath(ctx, Ray{x, wi}, region, c, rng, state);
+            Li[c] += 3 * weight[c] * p.L[c];
+            if (tallyHere) m.liDirect[c] += 3 * weight[c] * p.direct[c];
         }
     }
     return Li + photons();

@@ -41,6 +41,9 @@ struct MarcherScratch final : ThreadContextExtension {
     // Scattering events of the camera path so far (diffuse bounces): a march
     // sample is one more, and a continuation path starts from there.
     int pathDepth = 0;
+    // The direct / indirect AOVs (render.aovs): the camera path's direct
+    // part so far, and that of the last inScattered() result.
+    Color direct{0}, liDirect{0};
 };
 
 class SegmentMarcher : public Marcher {
@@ -48,9 +51,14 @@ public:
     SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination);
     PathResult radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
 
+private:
+    PathResult trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const;
+
 protected:
     // Marches [0, tEnd) of the ray in `region`, adding to L and attenuating
-    // beta. Returns false when Russian roulette ended the path.
+    // beta. Returns false when Russian roulette ended the path. With
+    // mTallyDirect it also adds L's direct part by tallyEmission and
+    // tallyInScattered.
     virtual bool marchSegment(ThreadContext& ctx, int region, const Ray& ray, float tEnd, Rng& rng, Color& L,
                               Color& beta) const = 0;
 
@@ -70,6 +78,16 @@ protected:
     // (infiniteTail; applyInfiniteTail then sets T(infinity) = 0 in every
     // channel that the fog extinguishes).
     bool activeIntervals(ThreadContext& ctx, int region, const Ray& ray, float tEnd, bool& infiniteTail) const;
+
+    // The direct AOV's share of a segment's contributions: emission `Le`
+    // (as added to L) is direct up to the first diffuse bounce; light in-
+    // scattered with `weight` (L += weight * L_i) brings the direct part of
+    // the last inScattered() result.
+    void tallyEmission(ThreadContext& ctx, const Color& Le) const {
+        MarcherScratch& m = scratch(ctx);
+        if (m.pathDepth <= 1) m.direct += Le;
+    }
+    void tallyInScattered(ThreadContext& ctx, const Color& weight) const { scratch(ctx).direct += weight * scratch(ctx).liDirect; }
     void applyInfiniteTail(int region, Color& beta) const;
 
     static MarcherScratch& scratch(ThreadContext& ctx) { return ctx.extensionAs<MarcherScratch>(); }
@@ -81,6 +99,7 @@ protected:
     const Scene& mScene;
     std::shared_ptr<const Illumination> mIllumination;
     const bool mChromatic;  // continuation paths track one channel
+    const bool mTallyDirect;  // render.aovs asks for direct or indirect
     bool mLastEventByNextEvent = true;  // see the constructor
     bool mProductSampling = false;      // render.product_sampling with a directional cache
 };

@@ -65,6 +65,19 @@ struct SurfaceDesc {
     bool smoothNormals = false;      // default true for vdb_isosurface
 };
 
+// Extra EXR layers a render may write (render.aovs; docs/aovs.md).
+struct AovSet {
+    bool depth = false, albedo = false, normal = false, direct = false, indirect = false;
+    bool any() const { return firstEvent() || splitDirect(); }
+    // Layers of the first event along the camera ray (a feature pass of its own).
+    bool firstEvent() const { return depth || albedo || normal; }
+    // Layers that split the beauty by scattering order.
+    bool splitDirect() const { return direct || indirect; }
+};
+
+// The names render.aovs accepts, in documentation order.
+const std::vector<std::string>& aovNames();
+
 struct RenderSettings {
     Method method = Method::Uniform;
     // render.method = "auto" (the default): `method` is chosen from what the
@@ -87,6 +100,7 @@ struct RenderSettings {
     // li = "path" with a directional cache (guided): continuation directions
     // from phase x cached radiance (cache/product_sampler.h), else the phase.
     bool productSampling = false;  // measured slower to converge on cloud_sun and exp1_sphere (BENCHMARKS.md)
+    AovSet aovs;  // none by default: the EXR holds RGBA only
 };
 
 // The volume photon map (scene key "photons").

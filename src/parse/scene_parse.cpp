@@ -1,6 +1,7 @@
 // Scene JSON -> SceneDesc. Reads fields only; files are loaded later.
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -273,9 +274,47 @@ SurfaceDesc parseSurface(const JsonReader& r) {
     return s;
 }
 
+// render.aovs: an array of names, or one string of comma-separated names
+// (what `--aovs depth,albedo` becomes).
+AovSet parseAovs(const JsonReader& r) {
+    const Json& v = r.raw("aovs");
+    std::vector<std::string> names;
+    if (v.is_string()) {
+        std::string item;
+        for (char c : v.get<std::string>() + ",") {
+            if (c != ',') {
+                if (c != ' ') item += c;
+            } else if (!item.empty()) {
+                names.push_back(item);
+                item.clear();
+            }
+        }
+    } else if (v.is_array()) {
+        for (const Json& e : v) {
+            if (!e.is_string()) r.fail("aovs", str("must list names as strings, got ", jsonExcerpt(e)));
+            names.push_back(e.get<std::string>());
+        }
+    } else {
+        r.fail("aovs", str("must be an array of names (or a comma-separated string), got ", jsonExcerpt(v)));
+    }
+    std::string allowed;
+    for (const std::string& n : aovNames()) allowed += (allowed.empty() ? "" : ", ") + n;
+    AovSet s;
+    bool* flags[] = {&s.depth, &s.albedo, &s.normal, &s.direct, &s.indirect};  // aovNames() order
+    for (const std::string& n : names) {
+        const auto it = std::find(aovNames().begin(), aovNames().end(), n);
+        if (it == aovNames().end())
+            r.fail("aovs", str("unknown AOV \"", n, "\" (allowed: ", allowed, ")"));
+        bool& flag = *flags[it - aovNames().begin()];
+        if (flag) r.fail("aovs", str("lists \"", n, "\" twice"));
+        flag = true;
+    }
+    return s;
+}
+
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
-                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling"});
+                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "aovs"});
     RenderSettings s;
     {
         std::vector<std::string> names = {"auto"};
@@ -302,6 +341,7 @@ RenderSettings parseRender(const JsonReader& r) {
     parseLiSource(r.choice("li", liSourceName(s.li), {"path", "photons", "cache"}), s.li);
     s.productSampling = r.boolean("product_sampling", s.productSampling);
     s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
+    if (r.has("aovs")) s.aovs = parseAovs(r);
     return s;
 }
 
@@ -344,6 +384,11 @@ CacheSettings parseCache(const JsonReader& r) {
 }
 
 }  // namespace
+
+const std::vector<std::string>& aovNames() {
+    static const std::vector<std::string> names = {"depth", "albedo", "normal", "direct", "indirect"};
+    return names;
+}
 
 std::string sceneHash(const SceneDesc& desc) {
     Json j = Json::parse(desc.jsonText);

@@ -13,6 +13,7 @@
 #include "core/memory.h"
 #include "core/threads.h"
 #include "marchers/marcher.h"
+#include "transport/first_event.h"
 
 namespace vdbmarch {
 
@@ -54,8 +55,70 @@ private:
 
 }  // namespace
 
-void checkImageMemory(int width, int height) {
-    const uint64_t perPixel = sizeof(Color) + sizeof(double) + 4 * sizeof(float);
+namespace {
+
+// The AOVs' per-pixel sums (only those render.aovs asks for are allocated).
+struct AovSums {
+    std::vector<double> depth;           // camera-space depth of the samples that met something
+    std::vector<uint32_t> depthSamples;  // how many did
+    std::vector<Color> albedo, normal, direct;
+
+    AovSums(const AovSet& aovs, size_t pixels) {
+        if (aovs.depth) {
+            depth.assign(pixels, 0.0);
+            depthSamples.assign(pixels, 0);
+        }
+        if (aovs.albedo) albedo.assign(pixels, Color(0));
+        if (aovs.normal) normal.assign(pixels, Color(0));
+        if (aovs.splitDirect()) direct.assign(pixels, Color(0));
+    }
+
+    // Bytes per pixel of the sums and the layers written from them.
+    static uint64_t bytesPerPixel(const AovSet& a) {
+        return (a.depth ? sizeof(double) + sizeof(uint32_t) + sizeof(float) : 0) +
+               (a.albedo ? sizeof(Color) + 3 * sizeof(float) : 0) + (a.normal ? sizeof(Color) + 3 * sizeof(float) : 0) +
+               (a.splitDirect() ? sizeof(Color) : 0) + (a.direct ? 3 * sizeof(float) : 0) +
+               (a.indirect ? 3 * sizeof(float) : 0);
+    }
+};
+
+// Random stream of the feature AOVs, apart from the beauty's.
+constexpr uint64_t AovStream = 0x616f7673;
+
+// The layers of the requested AOVs from their sums over `spp` samples. The
+// indirect layer is the beauty minus the direct one, so they add up to the
+// beauty exactly up to the rounding of that subtraction.
+std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const std::vector<Color>& beauty, int spp) {
+    std::vector<ExrLayer> layers;
+    const size_t pixels = beauty.size();
+    const float inv = 1.f / float(spp);
+    auto colorLayer = [&](const char* name, std::vector<std::string> channels, auto value) {
+        ExrLayer l{name, std::move(channels), {}};
+        l.pixels.reserve(3 * pixels);
+        for (size_t p = 0; p < pixels; ++p) {
+            const Color c = value(p);
+            l.pixels.insert(l.pixels.end(), {c.x, c.y, c.z});
+        }
+        layers.push_back(std::move(l));
+    };
+    if (aovs.depth) {
+        ExrLayer l{"depth", {"Z"}, std::vector<float>(pixels)};
+        for (size_t p = 0; p < pixels; ++p)
+            l.pixels[p] = s.depthSamples[p] > 0 ? float(s.depth[p] / double(s.depthSamples[p])) : NoDepth;
+        layers.push_back(std::move(l));
+    }
+    if (aovs.albedo) colorLayer("albedo", {"R", "G", "B"}, [&](size_t p) { return s.albedo[p] * inv; });
+    if (aovs.normal) colorLayer("normal", {"X", "Y", "Z"}, [&](size_t p) { return s.normal[p] * inv; });
+    if (aovs.direct) colorLayer("direct", {"R", "G", "B"}, [&](size_t p) { return s.direct[p] * inv; });
+    if (aovs.indirect)
+        colorLayer("indirect", {"R", "G", "B"}, [&](size_t p) { return beauty[p] * inv - s.direct[p] * inv; });
+    return layers;
+}
+
+}  // namespace
+
+void checkImageMemory(int width, int height, const AovSet& aovs) {
+    const uint64_t perPixel = sizeof(Color) + sizeof(double) + 4 * sizeof(float) + AovSums::bytesPerPixel(aovs);
     checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
@@ -63,7 +126,7 @@ void checkImageMemory(int width, int height) {
 RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const RenderSettings& rs = scene.desc.render;
     const int w = scene.camera->width(), h = scene.camera->height();
-    checkImageMemory(w, h);
+    checkImageMemory(w, h, rs.aovs);
     const int tilesX = (w + TileSize - 1) / TileSize, tilesY = (h + TileSize - 1) / TileSize;
     const int tiles = tilesX * tilesY;
     const bool timed = options.timeBudget > 0;
@@ -71,6 +134,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     result.image = Image(w, h);
     std::vector<Color> sums(size_t(w) * size_t(h), Color(0));
     std::vector<double> transmittances(size_t(w) * size_t(h), 0.0);
+    const AovSet& aovs = rs.aovs;
+    AovSums aovSums(aovs, size_t(w) * size_t(h));
     std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
     ProgressBar progress(options.progress, timed ? 1000 : tiles);
     const int threads = resolveThreadCount(rs.threads);
@@ -121,6 +186,19 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                                 }
                                 sum += pr.L;
                                 transmittance += pr.transmittance;
+                                if (aovs.any()) {
+                                    if (aovs.splitDirect()) aovSums.direct[pixel] += pr.direct;
+                                    if (aovs.firstEvent()) {
+                                        Rng aovRng(hashValues(rs.seed, pixel, AovStream), uint64_t(s));
+                                        const FirstEvent fe = traceFirstEvent(ctx, ray, aovRng);
+                                        if (aovs.depth && fe.hasDepth) {
+                                            aovSums.depth[pixel] += double(scene.camera->viewDepth(fe.depthPoint));
+                                            ++aovSums.depthSamples[pixel];
+                                        }
+                                        if (aovs.albedo) aovSums.albedo[pixel] += fe.albedo;
+                                        if (aovs.normal) aovSums.normal[pixel] += fe.normal;
+                                    }
+                                }
                             }
                         }
                     tileCounters[size_t(tile)] += ctx.counters;
@@ -185,6 +263,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             size_t pixel = size_t(y) * size_t(w) + size_t(x);
             result.image.set(x, y, sums[pixel] * inv, clamp(1.f - float(transmittances[pixel]) * inv, 0.f, 1.f));
         }
+    result.layers = aovLayers(aovs, aovSums, sums, spp);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (const auto& c : tileCounters) result.counters += c;
     return result;

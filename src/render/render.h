@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/stats.h"
+#include "image/exr_io.h"
 #include "image/image.h"
 #include "illumination/illumination.h"
 #include "scene/scene.h"
@@ -32,12 +33,19 @@ struct RenderResult {
     int threads = 0;      // worker threads used
     int spp = 0;          // samples per pixel actually rendered
     int photonPasses = 1; // progressive photon passes used (illumination/illumination.h)
+    // The AOVs render.aovs asks for, as EXR layers (docs/aovs.md), in the
+    // order depth, albedo, normal, direct, indirect.
+    std::vector<ExrLayer> layers;
 };
+
+// Depth AOV of a pixel whose samples met nothing: far, but finite so that
+// filters and defocus in a compositor stay finite (alpha says it is empty).
+constexpr float NoDepth = 1e10f;
 
 // Refuses (InputError naming camera.resolution) an image whose buffers do
 // not fit in this machine's memory: per pixel the RGB sum, the transmittance
-// sum and the RGBA result.
-void checkImageMemory(int width, int height);
+// sum and the RGBA result, and the sums and layers of the AOVs.
+void checkImageMemory(int width, int height, const AovSet& aovs = {});
 
 // Renders the scene with scene.desc.render's method, spp, seed and threads.
 // Deterministic: each pixel sample has its own random stream, so the image is

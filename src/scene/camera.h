@@ -13,6 +13,8 @@ public:
     Ray generateRay(float px, float py) const;
     int width() const { return mWidth; }
     int height() const { return mHeight; }
+    // Camera-space depth of p: its distance along the view axis (Cycles' Z pass).
+    float viewDepth(const Vec3& p) const { return dot(p - mPos, mForward); }
 
 private:
     bool mOrtho;

@@ -38,6 +38,12 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     const int maxDepth = scene.desc.render.maxDepth;
     const int startDepth = st.depth;
     Color L(0), beta(1);
+    // L when the path's second scattering event happened: the direct part
+    // (one copy per path, so the AOV costs nothing per contribution).
+    Color direct(0);
+    auto result = [&](float transmittance) {
+        return PathRadiance{L, transmittance, st.depth <= 1 ? L : direct};
+    };
     int surfaceBounces = 0;
     MediumPoint mp;
     while (true) {
@@ -64,7 +70,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             if (u >= sa + ss) return true;  // null collision
             // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
             beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
-            ++st.depth;
+            if (++st.depth == 2) direct = L;
             if (st.depth > maxDepth) {
                 beta = Color(0);
                 return false;
@@ -80,9 +86,9 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             scattered = true;
             return false;
         });
-        if (isBlack(beta)) return {L, 0.f};
+        if (isBlack(beta)) return result(0.f);
         if (scattered) {
-            if (!roulette(beta, st.depth, rng)) return {L, 0.f};
+            if (!roulette(beta, st.depth, rng)) return result(0.f);
             continue;
         }
         // Reached tEnd without a real collision.
@@ -97,7 +103,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 w = powerHeuristic(st.lastPdf, uniformConePdf(cosMax));
             }
             L += beta * l.emittedRadiance() * w;
-            return {L, 0.f};
+            return result(0.f);
         }
         if (!hit) {
             // An environment map was also sampled by next-event estimation
@@ -105,15 +111,15 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const Environment& env = scene.environment;
             const float w = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(ray.d)) : 1.f;
             L += beta * env.radiance(ray.d) * w;
-            return {L, st.depth == startDepth && surfaceBounces == 0 ? average(beta) : 0.f};
+            return result(st.depth == startDepth && surfaceBounces == 0 ? average(beta) : 0.f);
         }
         ++ctx.counters.surfaceHits;
-        if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return {L, 0.f};
+        if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return result(0.f);
         const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
         const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
-            ++st.depth;
-            if (st.depth > maxDepth) return {L, 0.f};
+            if (++st.depth == 2) direct = L;
+            if (st.depth > maxDepth) return result(0.f);
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
             L += beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, nextEventOptions(st));
             st.lastPdf = e.pdf;
@@ -125,7 +131,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         beta *= e.weight;
         ray = e.ray;
         region = e.region;
-        if (e.kind == SurfaceEvent::Kind::Diffuse && !roulette(beta, st.depth, rng)) return {L, 0.f};
+        if (e.kind == SurfaceEvent::Kind::Diffuse && !roulette(beta, st.depth, rng)) return result(0.f);
     }
 }
 

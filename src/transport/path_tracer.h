@@ -35,6 +35,10 @@ struct PathState {
 struct PathRadiance {
     Color L;              // radiance arriving at ray.o along -ray.d
     float transmittance;  // fraction of the background seen straight (camera paths)
+    // The part of L after at most one scattering event in all (counting the
+    // state's depth; emission and unscattered light included): the "direct"
+    // AOV. Zero for paths that start at depth >= 2.
+    Color direct;
 };
 
 // The radiance the path ray (in `region`) brings back, from `state`.
