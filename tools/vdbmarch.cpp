@@ -65,6 +65,8 @@ int main(int argc, char** argv) {
     render->add_flag("--force", ra.force, "Use a --cache baked for another scene (warns)");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or summary line");
     render->add_flag("--no-progress", ra.noProgress, "No progress bar");
+    render->add_flag("--preview", ra.preview,
+                     "A quick look: half the resolution, an eighth of the samples (or of --time), a quarter of the photons");
 
     CompareArgs ca;
     CLI::App* compare = app.add_subcommand("compare", "Error metrics of a test image against a reference (EXR)");

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -46,6 +47,14 @@ const SceneOptionTable<RenderArgs>& renderSceneOptions() {
 }
 
 namespace {
+
+// --preview: half the width and height, an eighth of the samples (at least
+// one), a quarter of the photons; everything else as the scene says.
+std::vector<std::string> previewOverrides(const SceneDesc& d) {
+    return {str("camera.resolution=[", std::max(1, d.camera.width / 2), ",", std::max(1, d.camera.height / 2), "]"),
+            str("render.spp=", std::max(1, (d.render.spp + 4) / 8)),
+            str("photons.count=", std::min<int64_t>(d.photons.count, std::max<int64_t>(1000, d.photons.count / 4)))};
+}
 
 // "guided", or "reference (auto: multiple scattering in open media)".
 std::string methodLabel(const RenderSettings& r) {
@@ -118,6 +127,13 @@ int runRender(const RenderArgs& a) {
 
     if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
     SceneDesc desc = loadSceneInput(a.input, overrides);
+    if (a.preview) {
+        // A quick look: the same scene with a quarter of the pixels, an
+        // eighth of the samples (or of the time) and a quarter of the photons.
+        const std::vector<std::string> p = previewOverrides(desc);
+        overrides.insert(overrides.end(), p.begin(), p.end());
+        desc = loadSceneInput(a.input, overrides);
+    }
     checkImageMemory(desc.camera.width, desc.camera.height, desc.render.aovs);  // before any volume is loaded
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -127,7 +143,7 @@ int runRender(const RenderArgs& a) {
     options.illumination.force = a.force;
     options.progress = !a.quiet && !a.noProgress && isatty(STDERR_FILENO);
     if (a.timeBudget) {
-        options.timeBudget = *a.timeBudget;
+        options.timeBudget = a.preview ? *a.timeBudget / 8 : *a.timeBudget;
         options.runStart = t0;
     }
     RenderResult r = renderImage(*scene, options);

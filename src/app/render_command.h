@@ -13,6 +13,7 @@ namespace vdbmarch {
 struct RenderArgs {
     std::string input, output, png, res, stats, saveScene, cache;
     bool force = false, quiet = false, noProgress = false;
+    bool preview = false;  // --preview: a quick look (previewOverrides in render_command.cpp)
     std::optional<double> timeBudget;  // --time
     std::vector<std::string> sets;     // --set key.path=value
     // Scene overrides (renderSceneOptions); unset ones keep the scene's values.

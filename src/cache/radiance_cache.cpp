@@ -319,7 +319,7 @@ RadianceCache RadianceCache::load(const std::string& path) {
         fileMeta = file.getMetadata();
         file.close();
     } catch (const std::exception& e) {
-        throw InputError(str(path, ": not a readable VDB cache file (", e.what(), ")"));
+        throw InputError(str(path, ": not a readable VDB cache file (", printableExcerpt(e.what()), ")"));
     }
     // The cache keys: on the file, or (re-saved by a tool that keeps only
     // grid metadata) on the level-0 grid of coefficient 0, which repeats them.

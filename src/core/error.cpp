@@ -32,4 +32,14 @@ void setWarningsQuiet(bool quiet) {
     gQuiet = quiet;
 }
 
+std::string printableExcerpt(const std::string& text, size_t max) {
+    std::string out;
+    for (char c : text) {
+        if (out.size() >= max) return out + "...";
+        const unsigned char u = static_cast<unsigned char>(c);
+        out.push_back(u >= 32 && u < 127 ? c : '?');
+    }
+    return out;
+}
+
 }  // namespace vdbmarch

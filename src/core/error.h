@@ -37,6 +37,11 @@ std::string str(const Args&... args) {
 
 // Warnings go through one sink so tests can capture them and counts stay honest.
 void warn(const std::string& message);
+
+// A library's message fit to quote in ours: control and non-ASCII bytes
+// become '?', and past `max` characters it is cut with "..." (a damaged
+// file can put kilobytes of garbage into an exception's text).
+std::string printableExcerpt(const std::string& text, size_t max = 240);
 // Number of warnings issued since the program started (for tests).
 int warningCount();
 // Last warning text (for tests).

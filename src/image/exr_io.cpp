@@ -36,6 +36,20 @@ int channelCount(Imf::InputFile& in) {
 
 const char* const RgbaNames[4] = {"R", "G", "B", "A"};
 
+// A damaged header can claim any data window (fuzzing: 11 GB asked of a
+// 1 kB file). Deflate shrinks at most ~1032:1 and every chunk costs bytes of
+// its own, so a window whose samples (at least 2 bytes each, as halfs) need
+// over 2^20 times the file's size cannot be in the file, whatever its
+// compression (a wide margin: a constant 16k x 16k RGBA image still passes).
+void checkDataWindowFits(const std::string& path, int64_t w, int64_t h, int channels, uint64_t fileBytes) {
+    if (w <= 0 || h <= 0 || w > (1 << 30) / h)
+        throw InputError(str("'", path, "' has an unsupported data window of ", w, "x", h));
+    const uint64_t minSampleBytes = uint64_t(w) * uint64_t(h) * 2 * uint64_t(std::max(1, channels));
+    if ((minSampleBytes >> 20) > fileBytes)
+        throw InputError(str("'", path, "' claims a ", w, "x", h, " data window that a file of ", fileBytes,
+                             " bytes cannot hold (damaged header?)"));
+}
+
 // OpenEXR allocates (and clears) what an attribute's size field claims
 // before reading its value: fuzzing found a 1.3 kB file whose string
 // attribute asks for gigabytes. Walk the header(s) first, as the format
@@ -71,6 +85,18 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
             if (size < 0 || uint64_t(size) > left)
                 throw InputError(str("'", path, "': damaged OpenEXR header: attribute '", name, "' (", type, ") claims ",
                                      size, " bytes, but only ", left, " follow"));
+            // The data window too, before OpenEXR sizes its line buffers by it
+            // (fuzzing: 160 MB of buffers for a 434-byte file).
+            if (name == "dataWindow" && type == "box2i" && size == 16) {
+                unsigned char box[16];
+                if (std::fread(box, 1, 16, f) != 16) break;
+                int32_t v[4];
+                for (int k = 0; k < 4; ++k)
+                    v[k] = int32_t(uint32_t(box[4 * k]) | uint32_t(box[4 * k + 1]) << 8 | uint32_t(box[4 * k + 2]) << 16 |
+                                   uint32_t(box[4 * k + 3]) << 24);
+                checkDataWindowFits(path, int64_t(v[2]) - v[0] + 1, int64_t(v[3]) - v[1] + 1, 1, fileBytes);
+                continue;
+            }
             std::fseek(f, size, SEEK_CUR);
         }
         if (!multiPart) break;
@@ -103,11 +129,11 @@ auto withInputFile(const std::string& path, Fn fn) -> decltype(fn(std::declval<I
     } catch (const InputError&) {
         throw;
     } catch (const Iex::ErrnoExc& e) {
-        throw IoError(str("cannot read '", path, "': ", e.what()));
+        throw IoError(str("cannot read '", path, "': ", printableExcerpt(e.what())));
     } catch (const std::bad_alloc&) {
         throw InputError(str("cannot read OpenEXR file '", path, "': out of memory (corrupt header?)"));
     } catch (const std::exception& e) {
-        throw InputError(str("cannot read OpenEXR file '", path, "': ", e.what()));
+        throw InputError(str("cannot read OpenEXR file '", path, "': ", printableExcerpt(e.what())));
     }
 }
 
@@ -171,20 +197,9 @@ Image readExr(const std::string& path) {
     return withInputFile(path, [&](Imf::InputFile& in) {
         const Imath::Box2i dw = in.header().dataWindow();
         const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
-        if (w <= 0 || h <= 0 || w > (1 << 30) / h)
-            throw InputError(str("'", path, "' has an unsupported data window of ", w, "x", h));
-        // A damaged header can claim any data window (fuzzing: 11 GB asked
-        // of a 1 kB file). Deflate shrinks at most ~1032:1 and every chunk
-        // costs bytes of its own, so a window whose samples (at least 2
-        // bytes each, as halfs) need over 2^20 times the file's size cannot
-        // be in the file, whatever its compression (a wide margin: a
-        // constant 16k x 16k RGBA image still passes).
         std::error_code ec;
         const uint64_t fileBytes = uint64_t(std::filesystem::file_size(path, ec));
-        const uint64_t minSampleBytes = uint64_t(w) * uint64_t(h) * 2 * uint64_t(std::max(1, channelCount(in)));
-        if (!ec && (minSampleBytes >> 20) > fileBytes)
-            throw InputError(str("'", path, "' claims a ", w, "x", h, " data window that a file of ", fileBytes,
-                                 " bytes cannot hold (damaged header?)"));
+        checkDataWindowFits(path, w, h, channelCount(in), ec ? UINT64_MAX : fileBytes);
         checkMemory(uint64_t(w) * uint64_t(h) * 4 * sizeof(float), str("'", path, "' (", w, "x", h, " pixels)"));
         const Imf::ChannelList& channels = in.header().channels();
         for (int c = 0; c < 3; ++c)

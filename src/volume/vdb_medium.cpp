@@ -71,10 +71,10 @@ public:
             gd.read(is);
             const std::string name = openvdb::io::GridDescriptor::nameAsString(gd.uniqueName());
             if (gd.getGridPos() < 0 || gd.getBlockPos() < gd.getGridPos() || gd.getEndPos() < gd.getBlockPos())
-                throw InputError(str(path, ": damaged VDB file: grid '", name, "' has inconsistent offsets (",
+                throw InputError(str(path, ": damaged VDB file: grid '", printableExcerpt(name, 80), "' has inconsistent offsets (",
                                      gd.getGridPos(), ", ", gd.getBlockPos(), ", ", gd.getEndPos(), ")"));
             if (gd.getEndPos() > size)
-                throw InputError(str(path, ": the VDB file is cut short: grid '", name, "' ends at byte ",
+                throw InputError(str(path, ": the VDB file is cut short: grid '", printableExcerpt(name, 80), "' ends at byte ",
                                      gd.getEndPos(), " but the file has ", size, " bytes; copy it again"));
             gd.seekToEnd(is);
         }
@@ -98,13 +98,13 @@ std::unique_ptr<openvdb::io::File> openVdbFile(const std::string& path) {
     } catch (const IoError&) {
         throw;
     } catch (const std::exception& e) {
-        throw InputError(str(path, ": not a readable OpenVDB file (", e.what(), ")"));
+        throw InputError(str(path, ": not a readable OpenVDB file (", printableExcerpt(e.what()), ")"));
     }
     auto file = std::make_unique<openvdb::io::File>(path);
     try {
         file->open(/*delayLoad=*/false);
     } catch (const std::exception& e) {
-        throw InputError(str(path, ": not a readable OpenVDB file (", e.what(), ")"));
+        throw InputError(str(path, ": not a readable OpenVDB file (", printableExcerpt(e.what()), ")"));
     }
     return file;
 }
@@ -112,7 +112,7 @@ std::unique_ptr<openvdb::io::File> openVdbFile(const std::string& path) {
 std::string gridListing(openvdb::io::File& file) {
     std::string names;
     auto grids = file.readAllGridMetadata();
-    for (const auto& g : *grids) names += str(names.empty() ? "" : ", ", "'", g->getName(), "' (", gridTypeName(*g), ")");
+    for (const auto& g : *grids) names += str(names.empty() ? "" : ", ", "'", printableExcerpt(g->getName(), 80), "' (", printableExcerpt(gridTypeName(*g), 80), ")");
     return names.empty() ? "none" : names;
 }
 
@@ -700,7 +700,7 @@ openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string
     try {
         base = file->readGrid(name);
     } catch (const std::exception& e) {
-        throw InputError(str(path, ": grid '", name, "' could not be read (", e.what(), ")"));
+        throw InputError(str(path, ": grid '", name, "' could not be read (", printableExcerpt(e.what()), ")"));
     }
     if (chosenName) *chosenName = name;
     if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(base)) return f;
@@ -773,7 +773,7 @@ size_t readEveryGrid(const std::string& path) {
         try {
             g = file->readGrid(*name);
         } catch (const std::exception& e) {
-            throw InputError(str(path, ": grid '", *name, "' could not be read (", e.what(), ")"));
+            throw InputError(str(path, ": grid '", *name, "' could not be read (", printableExcerpt(e.what()), ")"));
         }
         voxels += size_t(g->activeVoxelCount());
     }
