@@ -48,12 +48,21 @@ void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, i
 template <typename Collide>
 void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int channel, Rng& rng, Collide&& collide) {
     // `ray` is a copy: collide() may replace the caller's ray when it scatters.
+    // A majorant of over a million collisions per march step (coefficients
+    // near float's limits) would take steps below the resolution of t and
+    // never leave a region of tiny density (the stress suite's 1e30 media
+    // hung photon tracing): there, steps shorter than 1e-6 of a march step
+    // are lengthened to it. Positions are floats, so such a medium is opaque
+    // at that scale whatever the step; ordinary media never reach the rule.
+    const double minStep = 1e-6 * double(ctx.scene.step);
     auto track = [&](const MajorantSegment& seg) {
         const float sigmaMaj = seg.maxDensity;
         if (!(sigmaMaj > 0)) return true;
+        const bool absurd = double(sigmaMaj) * double(ctx.scene.step) > 1e6;
         double t = seg.t0;
         while (true) {
-            t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
+            const double dt = -std::log(1 - double(rng.uniform())) / sigmaMaj;
+            t += absurd ? std::max(dt, minStep) : dt;
             if (t >= seg.t1) return true;
             if (!collide(ray.at(t), sigmaMaj)) return false;
         }

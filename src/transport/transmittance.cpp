@@ -70,9 +70,13 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
         forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& seg) {
             const float sigmaMaj = mediumMajorant(seg.maxDensity, kMax);
             if (!(sigmaMaj > 0)) return true;
+            // The step floor of deltaTrack (tracking.h) for absurd majorants.
+            const bool absurd = double(sigmaMaj) * double(ctx.scene.step) > 1e6;
+            const double minStep = 1e-6 * double(ctx.scene.step);
             double t = seg.t0;
             while (true) {
-                t -= std::log(1 - double(rng.uniform())) / sigmaMaj;
+                const double dt = -std::log(1 - double(rng.uniform())) / sigmaMaj;
+                t += absurd ? std::max(dt, minStep) : dt;
                 if (t >= seg.t1) return true;
                 ++ctx.counters.shadowSamples;
                 const float d = q.density(r.at(t));
