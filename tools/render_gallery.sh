@@ -4,10 +4,11 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$ROOT/docs/gallery"
 mkdir -p "$OUT"
-for s in cloud plume sparse glass; do
+# Each with its own samples per pixel unless SPP is set.
+for s in cloud cloud_sky plume sparse glass; do
   res=320x240; [ "$s" = plume ] && res=240x320
   "$ROOT/build/bin/vdbmarch" render "$ROOT/vdb_samples/$s.json" -o "/tmp/vdbmarch_gallery_$s.exr" \
-      --png "$OUT/$s.png" --res "$res" --spp "${SPP:-16}"
+      --png "$OUT/$s.png" --res "$res" ${SPP:+--spp "$SPP"}
 done
 
 # The paper's scenes (vdb_samples/scenes), 640x480 with their own method
