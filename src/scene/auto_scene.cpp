@@ -61,7 +61,8 @@ nlohmann::json autoSceneJson(const std::string& vdbPath) {
                                  {"sigma_s", json::array({sigmaS, sigmaS, sigmaS})},
                                  {"g", 0.2}}});
     doc["background"] = json::array({0.18, 0.26, 0.42});
-    doc["render"] = {{"method", "uniform"}, {"spp", 4}};
+    // Multiple scattering (a white cloud), the method chosen from the scene.
+    doc["render"] = {{"method", "auto"}, {"spp", 48}, {"max_depth", 64}};
     return doc;
 }
 
