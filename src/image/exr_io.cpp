@@ -50,6 +50,20 @@ void checkDataWindowFits(const std::string& path, int64_t w, int64_t h, int chan
                              " bytes cannot hold (damaged header?)"));
 }
 
+// Bytes of the value of an OpenEXR attribute type read at a fixed size
+// (OpenEXR 3.1's TypedAttribute<T>::readValueFrom reads the type, whatever
+// the size field says); 0 for the types read by their size or content.
+int fixedExrValueBytes(const std::string& type) {
+    static const std::pair<const char*, int> kTypes[] = {
+        {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
+        {"int", 4}, {"float", 4}, {"double", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12},
+        {"v3d", 24}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"chromaticities", 32},
+        {"keycode", 28}, {"rational", 8}, {"timecode", 8}, {"tiledesc", 9}};
+    for (const auto& [t, n] : kTypes)
+        if (type == t) return n;
+    return 0;
+}
+
 // OpenEXR allocates (and clears) what an attribute's size field claims
 // before reading its value: fuzzing found a 1.3 kB file whose string
 // attribute asks for gigabytes. Walk the header(s) first, as the format
@@ -85,16 +99,64 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
             if (size < 0 || uint64_t(size) > left)
                 throw InputError(str("'", path, "': damaged OpenEXR header: attribute '", name, "' (", type, ") claims ",
                                      size, " bytes, but only ", left, " follow"));
+            // OpenEXR reads the value of a type it knows by the type, not by
+            // the size field (fuzzing: a channel list whose size disagreed
+            // sent our walk and OpenEXR's apart), so follow it: fixed-size
+            // types take their own size, a channel list its entries (name\0
+            // and 16 bytes each, up to an empty name).
+            const int fixed = fixedExrValueBytes(type);
+            if (fixed > 0 && type != "box2i") {
+                std::fseek(f, fixed, SEEK_CUR);
+                continue;
+            }
+            if (type == "chlist") {
+                for (std::string channel;;) {
+                    readString(channel);
+                    if (channel.empty()) break;
+                    if (std::fseek(f, 16, SEEK_CUR) != 0)
+                        throw InputError(str("'", path, "': damaged OpenEXR header (cut inside the channel list)"));
+                }
+                continue;
+            }
+            // A preview image is allocated from its own width and height.
+            if (type == "preview") {
+                unsigned char wh[8];
+                if (std::fread(wh, 1, 8, f) != 8) break;
+                const uint64_t pw = uint64_t(wh[0]) | uint64_t(wh[1]) << 8 | uint64_t(wh[2]) << 16 | uint64_t(wh[3]) << 24;
+                const uint64_t ph = uint64_t(wh[4]) | uint64_t(wh[5]) << 8 | uint64_t(wh[6]) << 16 | uint64_t(wh[7]) << 24;
+                if (pw * ph * 4 > left)
+                    throw InputError(str("'", path, "': damaged OpenEXR header: the preview image claims ", pw, "x", ph,
+                                         " pixels, but only ", left, " bytes follow"));
+                std::fseek(f, long(pw * ph * 4), SEEK_CUR);
+                continue;
+            }
+            // A string vector: each string's own length is allocated first.
+            if (type == "stringvector") {
+                int64_t read = 0;
+                while (read < size) {
+                    unsigned char l[4];
+                    if (std::fread(l, 1, 4, f) != 4) break;
+                    const int32_t len = int32_t(uint32_t(l[0]) | uint32_t(l[1]) << 8 | uint32_t(l[2]) << 16 | uint32_t(l[3]) << 24);
+                    read += 4;
+                    if (len < 0 || int64_t(len) > int64_t(size) - read)
+                        throw InputError(str("'", path, "': damaged OpenEXR header: a string of attribute '", name,
+                                             "' claims ", len, " bytes, beyond the attribute's ", size));
+                    std::fseek(f, len, SEEK_CUR);
+                    read += len;
+                }
+                continue;
+            }
             // The data window too, before OpenEXR sizes its line buffers by it
             // (fuzzing: 160 MB of buffers for a 434-byte file).
-            if (name == "dataWindow" && type == "box2i" && size == 16) {
+            if (type == "box2i") {
                 unsigned char box[16];
                 if (std::fread(box, 1, 16, f) != 16) break;
                 int32_t v[4];
                 for (int k = 0; k < 4; ++k)
                     v[k] = int32_t(uint32_t(box[4 * k]) | uint32_t(box[4 * k + 1]) << 8 | uint32_t(box[4 * k + 2]) << 16 |
                                    uint32_t(box[4 * k + 3]) << 24);
-                checkDataWindowFits(path, int64_t(v[2]) - v[0] + 1, int64_t(v[3]) - v[1] + 1, 1, fileBytes);
+                if (name == "dataWindow")
+                    checkDataWindowFits(path, int64_t(v[2]) - v[0] + 1, int64_t(v[3]) - v[1] + 1, 1, fileBytes);
                 continue;
             }
             std::fseek(f, size, SEEK_CUR);

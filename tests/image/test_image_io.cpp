@@ -148,6 +148,29 @@ TEST_F(ImageIoTest, ReadExrRefusesAnAttributeSizeTheFileCannotHold) {
     EXPECT_EQ(readExrStringAttributes(path("a.exr")).size(), 1u);
 }
 
+// Fuzzing finding (fuzz_exr, third run): OpenEXR reads a channel list by
+// its entries and fixed-size types by their type, whatever the size field
+// says, so a wrong size there desynchronised a walk that skipped by size and
+// let a later attribute's huge size through. The walk follows OpenEXR: the
+// string after a mis-sized channel list is still refused.
+TEST_F(ImageIoTest, HeaderWalkFollowsOpenExrPastAMisSizedChannelList) {
+    writeExr(path("a.exr"), makeTestImage(8, 8), {{"vdbmarch:note", "hello"}});
+    std::string bytes = readBytes(path("a.exr"));
+    auto setSize = [&](const std::string& name, const std::string& type, int32_t size) {
+        const std::string key = name + '\0' + type + '\0';
+        const size_t at = bytes.find(key);
+        ASSERT_NE(at, std::string::npos) << name;
+        std::memcpy(&bytes[at + key.size()], &size, sizeof size);
+    };
+    setSize("channels", "chlist", 1);
+    setSize("compression", "compression", 7);
+    setSize("vdbmarch:note", "string", 1744830468);
+    writeText(path("bad.exr"), bytes);
+    const std::string msg = errorOf<InputError>([&] { readExr(path("bad.exr")); });
+    EXPECT_CONTAINS(msg, "vdbmarch:note");
+    EXPECT_CONTAINS(msg, "1744830468");
+}
+
 TEST_F(ImageIoTest, ExrRejectsReservedAttributeWithoutTouchingExistingFile) {
     writeText(path("keep.exr"), "old contents");
     EXPECT_THROW(writeExr(path("keep.exr"), makeTestImage(2, 2), {{"compression", "none"}}), InputError);
