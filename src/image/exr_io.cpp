@@ -85,6 +85,7 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
         }
     };
     std::string name, type;
+    int channels = 1;  // until the channel list is read (OpenEXR writes it first)
     while (true) {
         while (true) {
             readString(name);
@@ -110,9 +111,11 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
                 continue;
             }
             if (type == "chlist") {
+                channels = 0;
                 for (std::string channel;;) {
                     readString(channel);
                     if (channel.empty()) break;
+                    ++channels;
                     if (std::fseek(f, 16, SEEK_CUR) != 0)
                         throw InputError(str("'", path, "': damaged OpenEXR header (cut inside the channel list)"));
                 }
@@ -156,7 +159,7 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
                     v[k] = int32_t(uint32_t(box[4 * k]) | uint32_t(box[4 * k + 1]) << 8 | uint32_t(box[4 * k + 2]) << 16 |
                                    uint32_t(box[4 * k + 3]) << 24);
                 if (name == "dataWindow")
-                    checkDataWindowFits(path, int64_t(v[2]) - v[0] + 1, int64_t(v[3]) - v[1] + 1, 1, fileBytes);
+                    checkDataWindowFits(path, int64_t(v[2]) - v[0] + 1, int64_t(v[3]) - v[1] + 1, channels, fileBytes);
                 continue;
             }
             std::fseek(f, size, SEEK_CUR);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <set>
 #include <string>
@@ -169,6 +170,21 @@ TEST_F(ImageIoTest, HeaderWalkFollowsOpenExrPastAMisSizedChannelList) {
     const std::string msg = errorOf<InputError>([&] { readExr(path("bad.exr")); });
     EXPECT_CONTAINS(msg, "vdbmarch:note");
     EXPECT_CONTAINS(msg, "1744830468");
+}
+
+// Every EXR that fuzz_exr flagged (tests/image/fuzz_findings: damaged size
+// fields and data windows that made OpenEXR allocate hundreds of megabytes
+// to gigabytes before failing) is refused by name as damaged input.
+TEST(ExrFuzzFindings, EveryFindingIsRefusedNamingTheFile) {
+    const std::string dir = test::sourcePath("tests/image/fuzz_findings");
+    int files = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        const std::string file = entry.path().string();
+        const std::string msg = errorOf<InputError>([&] { readExr(file); });
+        EXPECT_CONTAINS(msg, file);
+        ++files;
+    }
+    EXPECT_GE(files, 5);
 }
 
 TEST_F(ImageIoTest, ExrRejectsReservedAttributeWithoutTouchingExistingFile) {

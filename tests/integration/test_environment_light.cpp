@@ -39,13 +39,17 @@ int sppFor(Method m) { return m == Method::Uniform ? 4 : 16; }
 struct Difference {
     SampleStats d, mean;
 };
-Difference difference(const Image& a, const Image& b) {
+// `what` labels the VDBMARCH_VERBOSE printout.
+Difference difference(const Image& a, const Image& b, Method m, const char* what) {
     Difference r;
     for (int y = 0; y < a.height; ++y)
         for (int x = 0; x < a.width; ++x) {
             r.d.add(average(a.rgb(x, y)) - average(b.rgb(x, y)));
             r.mean.add(average(a.rgb(x, y)));
         }
+    if (std::getenv("VDBMARCH_VERBOSE"))
+        std::printf("%s %s: mean diff %.4g (%.2f%% of %.4g), %.1f SE\n", methodName(m), what, r.d.mean(),
+                    100 * r.d.mean() / r.mean.mean(), r.mean.mean(), r.d.mean() / r.d.stdError());
     return r;
 }
 
@@ -68,10 +72,7 @@ TEST_P(EnvironmentLight, ConstantMapEqualsTheConstantBackground) {
     std::vector<std::string> withMap = cloudOverrides(m, sppFor(m), 4);
     withMap.push_back(str("environment={\"file\": \"", dir / "sky.exr", "\"}"));
     const Image a = render(withBackground), b = render(withMap);
-    const Difference r = difference(a, b);
-    if (std::getenv("VDBMARCH_VERBOSE"))
-        std::printf("%s constant map: mean diff %.4g (%.2f%% of %.4g), %.1f SE\n", methodName(m), r.d.mean(),
-                    100 * r.d.mean() / r.mean.mean(), r.mean.mean(), r.d.mean() / r.d.stdError());
+    const Difference r = difference(a, b, m, "constant map");
     EXPECT_NEAR(r.d.mean(), 0.0, 4 * r.d.stdError()) << methodName(m);
     // The top-left corner of the frame misses the cloud: the sky, up to the
     // rounding of the average over samples.
@@ -112,10 +113,7 @@ TEST_P(EnvironmentLight, SmallPatchMatchesTheDirectionalLight) {
     std::vector<std::string> withMap = cloudOverrides(m, sppFor(m), 6);
     withMap.push_back(str("environment={\"file\": \"", dir / "patch.exr", "\"}"));
     const Image a = render(withLight), b = render(withMap);
-    const Difference r = difference(a, b);
-    if (std::getenv("VDBMARCH_VERBOSE"))
-        std::printf("%s patch vs directional: mean diff %.4g (%.2f%% of %.4g), %.1f SE\n", methodName(m), r.d.mean(),
-                    100 * r.d.mean() / r.mean.mean(), r.mean.mean(), r.d.mean() / r.d.stdError());
+    const Difference r = difference(a, b, m, "patch vs directional");
     EXPECT_GT(r.mean.mean(), 0.02);  // the patch lights the cloud
     EXPECT_NEAR(r.d.mean(), 0.0, 4 * r.d.stdError() + 0.01 * r.mean.mean()) << methodName(m);
 }

@@ -234,6 +234,7 @@ std::unique_ptr<Scene> sceneFromJson(const std::string& json, const std::string&
 }
 
 std::string samplePath(const std::string& name) { return std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/" + name; }
+std::string sourcePath(const std::string& relative) { return std::string(VDBMARCH_SOURCE_DIR) + "/" + relative; }
 
 std::string assetPath(const std::string& name) {
     return std::string(VDBMARCH_SOURCE_DIR) + "/../shared/assets/" + name;

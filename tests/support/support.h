@@ -215,6 +215,8 @@ std::unique_ptr<Scene> sceneFromJson(const std::string& json, const std::string&
 
 // The scenes of vdb_samples/ ("cloud.json", "glass.json").
 std::string samplePath(const std::string& name);
+// A file or folder of the source tree, e.g. "tests/image/fuzz_findings".
+std::string sourcePath(const std::string& relative);
 // A file of shared/assets next to the checkout (the test skips without it).
 std::string assetPath(const std::string& name);
 
