@@ -63,7 +63,10 @@ PathResult SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& 
             return {L, 0.f};
         }
         if (!hit) {
-            if (!lightsCounted) addSeen(beta * scene.environment.radiance(ray.d));
+            // The camera path seen straight (or through glass): the map as a backdrop.
+            if (!lightsCounted)
+                addSeen(beta * (diffuseBounces == 0 ? scene.environment.radianceSeen(ray.d)
+                                                     : scene.environment.radiance(ray.d)));
             return {L, diffuseBounces > 0 ? 0.f : average(beta)};  // a diffuse surface is opaque
         }
         ++ctx.counters.surfaceHits;

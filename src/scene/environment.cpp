@@ -105,6 +105,23 @@ Color Environment::radiance(const Vec3& w) const {
     return texel(u, v);
 }
 
+Color Environment::radianceSeen(const Vec3& w) const {
+    if (!hasMap()) return mConstant;
+    float u, v;
+    directionToUv(toLocal(w), u, v);
+    const float x = u * float(mWidth) - 0.5f, y = v * float(mHeight) - 0.5f;
+    const float fx = std::floor(x), fy = std::floor(y);
+    const float tx = x - fx, ty = y - fy;
+    auto at = [&](int ix, int iy) -> const Color& {
+        ix = ((ix % mWidth) + mWidth) % mWidth;  // azimuth wraps
+        iy = std::min(mHeight - 1, std::max(0, iy));
+        return mTexels[size_t(iy) * size_t(mWidth) + size_t(ix)];
+    };
+    const int ix = int(fx), iy = int(fy);
+    return (at(ix, iy) * (1 - tx) + at(ix + 1, iy) * tx) * (1 - ty) +
+           (at(ix, iy + 1) * (1 - tx) + at(ix + 1, iy + 1) * tx) * ty;
+}
+
 bool Environment::sample(float u1, float u2, Vec3& w, float& pdf, Color& radianceOverPdf) const {
     if (!hasMap()) {
         w = sampleUniformSphere(u1, u2);

@@ -39,8 +39,14 @@ public:
     bool hasMap() const { return mWidth > 0; }
     bool isBlack() const { return hasMap() ? !(mIntegralAvg > 0) : vdbmarch::isBlack(mConstant); }
 
-    // Radiance arriving along -w, i.e. seen looking in direction w (unit).
+    // Radiance arriving along -w, i.e. seen looking in direction w (unit):
+    // constant over each texel, the function the light sampling below has
+    // its pdf for.
     Color radiance(const Vec3& w) const;
+    // The map as a backdrop, where a camera path that has not scattered
+    // sees it (no MIS involved): bilinear between texel centres, so a sky
+    // gradient does not show its texel rows.
+    Color radianceSeen(const Vec3& w) const;
     // A direction w by the map's texel power (radiance x solid angle), its
     // solid-angle pdf, and radiance(w) / pdf. False (pdf 0) if none.
     bool sample(float u1, float u2, Vec3& w, float& pdf, Color& radianceOverPdf) const;

@@ -110,7 +110,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             // at the last vertex (direct_light.cpp): weigh the two by MIS.
             const Environment& env = scene.environment;
             const float w = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(ray.d)) : 1.f;
-            L += beta * env.radiance(ray.d) * w;
+            // A camera path that never scattered sees the map as a backdrop.
+            L += beta * (st.depth == 0 ? env.radianceSeen(ray.d) : env.radiance(ray.d)) * w;
             return result(st.depth == startDepth && surfaceBounces == 0 ? average(beta) : 0.f);
         }
         ++ctx.counters.surfaceHits;

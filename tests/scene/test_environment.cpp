@@ -65,6 +65,32 @@ TEST(Environment, RadianceReadsTheTexelAndRotationTurnsAboutY) {
     EXPECT_EQ(turned.radiance(justBelowPlusZ), Color(0));
 }
 
+// The backdrop lookup: texel values at texel centres, the mean of two
+// neighbours half-way between them, across the azimuth seam too; a flat
+// map stays flat.
+TEST(Environment, BackdropIsBilinearBetweenTexelCentres) {
+    const int w = 8, h = 4;
+    std::vector<Color> t(size_t(w * h), Color(0));
+    t[size_t(1 * w + 2)] = Color(4, 0, 0);
+    t[size_t(1 * w + 3)] = Color(0, 4, 0);
+    t[size_t(1 * w + 7)] = Color(0, 0, 8);
+    t[size_t(1 * w + 0)] = Color(8, 0, 0);
+    const Environment env(t, w, h, 1, 0);
+    auto dir = [&](float x, float y) { return Environment::uvToDirection(x / w, y / h); };
+    const Color centre = env.radianceSeen(dir(2.5f, 1.5f));
+    EXPECT_NEAR(centre.x, 4, 1e-4f);
+    EXPECT_NEAR(centre.y, 0, 1e-4f);
+    const Color between = env.radianceSeen(dir(3.f, 1.5f));
+    EXPECT_NEAR(between.x, 2, 1e-4f);
+    EXPECT_NEAR(between.y, 2, 1e-4f);
+    const Color seam = env.radianceSeen(dir(8.f - 1e-4f, 1.5f));  // between column 7 and column 0
+    EXPECT_NEAR(seam.z, 4, 1e-3f);
+    EXPECT_NEAR(seam.x, 4, 1e-3f);
+    const Environment flat(std::vector<Color>(size_t(w * h), Color(0.5f)), w, h, 1, 0);
+    for (float y : {0.1f, 1.5f, 3.9f})
+        for (float x : {0.f, 3.3f, 7.99f}) EXPECT_NEAR(flat.radianceSeen(dir(x, y)).x, 0.5f, 1e-6f);
+}
+
 TEST(Environment, PdfIntegratesToOneAndMatchesSampling) {
     const int w = 32, h = 16;
     const Environment env(skyTexels(w, h, 20, 5, 2, 40), w, h, 1, 30);
