@@ -465,8 +465,9 @@ SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
     if (root.has("environment")) {
         JsonReader e = root.object("environment");
         e.allowOnly({"file", "scale", "rotation"});
-        scene.environment.file = resolvePath(scene.baseDir, e.string("file"));
-        if (e.string("file").empty()) e.fail("file", "must name a lat-long EXR file");
+        const std::string file = e.string("file");
+        if (file.empty()) e.fail("file", "must name a lat-long EXR file");
+        scene.environment.file = resolvePath(scene.baseDir, file);
         scene.environment.scale = float(e.numberIn("scale", 1, 0, 1e30));
         scene.environment.rotationDeg = float(e.numberIn("rotation", 0, -36000, 36000));
         if (!isBlack(scene.background))

@@ -452,20 +452,7 @@ TEST(PhotonEmissionEnvironment, MapDeliversItsIrradiance) {
     PhotonEmitter e = PhotonEmitter::forEnvironment(env, target);
     double r = targetRadius(target);
     expectPowerNear(e.power(), env.integral() * float(PiD * r * r));
-    auto irradiance = [&](const Vec3& n) {
-        double sum = 0;
-        const int sub = 8;
-        for (int y = 0; y < h * sub; ++y)
-            for (int x = 0; x < w * sub; ++x) {
-                const double t0 = PiD * y / (h * sub), t1 = PiD * (y + 1) / (h * sub);
-                const double dOmega = 2 * PiD / (w * sub) * (std::cos(t0) - std::cos(t1));
-                const Vec3 l = Environment::uvToDirection((x + 0.5f) / (w * sub), (y + 0.5f) / (h * sub));
-                const double a = 20 * PiD / 180;  // the map's rotation
-                const Vec3 d(float(std::cos(a) * l.x + std::sin(a) * l.z), l.y, float(-std::sin(a) * l.x + std::cos(a) * l.z));
-                sum += double(env.radiance(d).x) * std::max(0.0, double(dot(d, n))) * dOmega;
-            }
-        return sum;
-    };
+    auto irradiance = [&](const Vec3& n) { return environmentIrradianceByQuadrature(env, n, 20); };
     std::vector<TestDisc> discs;
     for (auto [x, n] : std::vector<std::pair<Vec3, Vec3>>{
              {{0, 0, 1}, {0, 1, 0}}, {{0.7f, -0.3f, 0.2f}, {1, -1, 0}}, {{-0.6f, 0.3f, 1.7f}, {-1, 2, -3}}})

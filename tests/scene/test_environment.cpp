@@ -145,19 +145,7 @@ TEST(Environment, LightSamplingEstimatesIrradianceAndIntegral) {
     const Environment env(skyTexels(w, h, 40, 9, 3, 60), w, h, 1.5f, -50);
     const std::vector<Vec3> normals = {{0, 1, 0}, normalize(Vec3(1, 0.2f, -0.4f)), normalize(Vec3(-0.3f, -1, 0.5f))};
     for (const Vec3& n : normals) {
-        double truth = 0;
-        const int sub = 8;
-        for (int y = 0; y < h * sub; ++y)
-            for (int x = 0; x < w * sub; ++x) {
-                const double t0 = PiD * y / (h * sub), t1 = PiD * (y + 1) / (h * sub);
-                const double dOmega = 2 * PiD / (w * sub) * (std::cos(t0) - std::cos(t1));
-                const Vec3 local = Environment::uvToDirection((x + 0.5f) / (w * sub), (y + 0.5f) / (h * sub));
-                // The map is turned by -50 degrees: world = R(-50) local.
-                const double a = -50 * PiD / 180;
-                const Vec3 d(float(std::cos(a) * local.x + std::sin(a) * local.z), local.y,
-                             float(-std::sin(a) * local.x + std::cos(a) * local.z));
-                truth += double(env.radiance(d).x) * std::max(0.0, double(dot(d, n))) * dOmega;
-            }
+        const double truth = environmentIrradianceByQuadrature(env, n, -50);
         SampleStats e, integral;
         Rng rng(21);
         for (int i = 0; i < 400000; ++i) {

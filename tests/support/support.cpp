@@ -234,6 +234,21 @@ std::unique_ptr<Scene> sceneFromJson(const std::string& json, const std::string&
 }
 
 std::string samplePath(const std::string& name) { return std::string(VDBMARCH_SOURCE_DIR) + "/vdb_samples/" + name; }
+double environmentIrradianceByQuadrature(const Environment& env, const Vec3& n, float rotationDeg, int sub) {
+    const double pi = 3.14159265358979323846, a = double(rotationDeg) * pi / 180;
+    const int w = env.width() * sub, h = env.height() * sub;
+    double sum = 0;
+    for (int y = 0; y < h; ++y) {
+        const double dOmega = 2 * pi / w * (std::cos(pi * y / h) - std::cos(pi * (y + 1) / h));
+        for (int x = 0; x < w; ++x) {
+            const Vec3 l = Environment::uvToDirection((x + 0.5f) / float(w), (y + 0.5f) / float(h));
+            const Vec3 d(float(std::cos(a) * l.x + std::sin(a) * l.z), l.y, float(-std::sin(a) * l.x + std::cos(a) * l.z));
+            sum += double(env.radiance(d).x) * std::max(0.0, double(dot(d, n))) * dOmega;
+        }
+    }
+    return sum;
+}
+
 std::string sourcePath(const std::string& relative) { return std::string(VDBMARCH_SOURCE_DIR) + "/" + relative; }
 
 std::string assetPath(const std::string& name) {

@@ -30,6 +30,7 @@
 #include "parse/scene_desc.h"
 #include "render/render.h"
 #include "scene/lights.h"
+#include "scene/environment.h"
 #include "scene/scene.h"
 
 namespace vdbmarch {
@@ -215,6 +216,12 @@ std::unique_ptr<Scene> sceneFromJson(const std::string& json, const std::string&
 
 // The scenes of vdb_samples/ ("cloud.json", "glass.json").
 std::string samplePath(const std::string& name);
+// Irradiance (red channel) that `env`, a width x height map turned by
+// rotationDeg about +Y, gives a surface with normal n: the sum over
+// sub x sub sub-texels of L cos dOmega, an independent quadrature of what
+// light sampling and photon emission estimate.
+double environmentIrradianceByQuadrature(const Environment& env, const Vec3& n, float rotationDeg, int sub = 8);
+
 // A file or folder of the source tree, e.g. "tests/image/fuzz_findings".
 std::string sourcePath(const std::string& relative);
 // A file of shared/assets next to the checkout (the test skips without it).
