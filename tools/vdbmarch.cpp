@@ -16,6 +16,7 @@
 #include "app/compare_command.h"
 #include "app/info_command.h"
 #include "app/inspect_command.h"
+#include "app/merge_command.h"
 #include "app/render_command.h"
 #include "app/vdb_check.h"
 #include "core/atomic_file.h"
@@ -65,6 +66,10 @@ int main(int argc, char** argv) {
     render->add_flag("--force", ra.force, "Use a --cache baked for another scene (warns)");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or summary line");
     render->add_flag("--no-progress", ra.noProgress, "No progress bar");
+    render->add_option("--tile", ra.tile,
+                       "Render tile I of N (0-based) of a fixed split of the frame into N bands of rows; the EXR's "
+                       "data window is the tile (vdbmarch merge assembles tiles)");
+    render->add_option("--crop", ra.crop, "Render only pixels [x0, x1) x [y0, y1) of the frame: x0,y0,x1,y1");
     render->add_flag("--preview", ra.preview,
                      "A quick look: half the resolution, an eighth of the samples (or of --time), a quarter of the photons");
 
@@ -73,6 +78,19 @@ int main(int argc, char** argv) {
     compare->add_option("test", ca.test, "Test image (.exr)")->required();
     compare->add_option("reference", ca.reference, "Reference image (.exr)")->required();
     compare->add_option("--diff", ca.diff, "Write a false-colour difference PNG");
+    compare->add_flag("--identical", ca.identical,
+                      "Only check bit-identity of every channel of every pixel (and the windows): exit 0 if "
+                      "identical, 1 if not");
+
+    MergeArgs ma;
+    CLI::App* merge = app.add_subcommand(
+        "merge", "Assemble the tiles of one render (render --tile / --crop) into the whole frame, checking that they "
+                 "belong together; nothing is written on error");
+    merge->add_option("tiles", ma.tiles, "Tile EXR files")->required();
+    merge->add_option("-o,--output", ma.output, "Output image (.exr)")->required();
+    merge->add_option("--png", ma.png, "Also write an sRGB PNG preview");
+    merge->add_option("--exposure", ma.exposure, "PNG exposure in stops (default: the scene's render.exposure)");
+    merge->add_flag("-q,--quiet", ma.quiet, "No summary line");
 
     BenchArgs ba;
     CLI::App* bench = app.add_subcommand("bench", "Run time against error: methods x budgets against a reference");
@@ -138,6 +156,7 @@ int main(int argc, char** argv) {
     try {
         if (*render) return runRender(ra);
         if (*compare) return runCompare(ca);
+        if (*merge) return runMerge(ma);
         if (*info) return runInfo(fa);
         if (*check) return runCheck(cka);
         if (*bake) return runBake(ka);

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/tiles.h"
 #include "app/vdb_check.h"
 #include "core/atomic_file.h"
 #include "image/exr_io.h"
@@ -83,6 +84,7 @@ void validate(const RenderArgs& a) {
         throw InputError(str("--time ", *a.timeBudget, ": must be a positive number of seconds"));
     if (a.timeBudget && a.spp)
         throw InputError("--time and --spp both given: a render is budgeted either by samples or by seconds");
+    parseTileRequest(a.tile, a.crop);
 }
 
 // Timings, counts and counters of a finished render (--stats).
@@ -134,7 +136,9 @@ int runRender(const RenderArgs& a) {
         overrides.insert(overrides.end(), p.begin(), p.end());
         desc = loadSceneInput(a.input, overrides);
     }
-    checkImageMemory(desc.camera.width, desc.camera.height, desc.render.aovs);  // before any volume is loaded
+    const TileRequest tile = parseTileRequest(a.tile, a.crop);
+    const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
+    checkImageMemory(window.width(), window.height(), desc.render.aovs);  // before any volume is loaded
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -146,6 +150,7 @@ int runRender(const RenderArgs& a) {
         options.timeBudget = a.preview ? *a.timeBudget / 8 : *a.timeBudget;
         options.runStart = t0;
     }
+    if (tile.any()) options.crop = window;
     RenderResult r = renderImage(*scene, options);
     if (r.counters.nonFiniteSamples > 0)
         warn(str(r.counters.nonFiniteSamples, " path sample(s) gave NaN or Inf and were dropped"));
@@ -162,15 +167,21 @@ int runRender(const RenderArgs& a) {
         {"vdbmarch:shadowStep", str(scene->shadowStep)},
         {"vdbmarch:renderSeconds", str(r.seconds)},
         {"vdbmarch:scene", desc.jsonText},
+        {RenderHashAttribute, renderHash(desc, a.cache)},
     };
-    writeExr(a.output, r.image, attrs, r.layers);
+    if (!a.cache.empty()) attrs.emplace_back("vdbmarch:cache", a.cache);
+    for (auto& kv : tileAttributes(tile)) attrs.push_back(std::move(kv));
+    writeExr(a.output, r.image, attrs, r.layers,
+             ExrWindow{r.window, PixelRect{0, 0, scene->camera->width(), scene->camera->height()}});
     if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
     if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total));
     if (!a.quiet)
-        std::fprintf(stderr, "vdbmarch: %dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
-                     r.image.width, r.image.height, r.spp, methodLabel(desc.render).c_str(), double(scene->step),
+        std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
+                     tile.count > 0 ? str("tile ", tile.index, "/", tile.count, " (rows ", r.window.y0, "-", r.window.y1 - 1, ") of ").c_str()
+                     : tile.cropped ? str("crop ", a.crop, " of ").c_str() : "",
+                     scene->camera->width(), scene->camera->height(), r.spp, methodLabel(desc.render).c_str(), double(scene->step),
                      r.seconds,
                      r.illuminationSeconds > 0
                          ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s in ",

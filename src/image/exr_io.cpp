@@ -205,13 +205,21 @@ auto withInputFile(const std::string& path, Fn fn) -> decltype(fn(std::declval<I
 }  // namespace
 
 void writeExr(const std::string& path, const Image& img, const StringAttributes& attributes,
-              const std::vector<ExrLayer>& layers) {
+              const std::vector<ExrLayer>& layers, const std::optional<ExrWindow>& window) {
     if (img.empty()) throw InputError(str("cannot write '", path, "': image is empty"));
     if (img.rgba.size() != img.pixelCount() * 4)
         throw InputError(str("cannot write '", path, "': pixel buffer does not match ", img.width,
                              "x", img.height));
+    const ExrWindow win = window ? *window : wholeFrame(img);
+    if (win.data.width() != img.width || win.data.height() != img.height || win.display.x0 != 0 ||
+        win.display.y0 != 0 || !win.display.contains(win.data))
+        throw InputError(str("cannot write '", path, "': data window [", win.data.x0, ", ", win.data.x1, ") x [",
+                             win.data.y0, ", ", win.data.y1, ") of a ", img.width, "x", img.height,
+                             " image does not fit the ", win.display.width(), "x", win.display.height(), " frame"));
+    const Imath::Box2i displayWindow(Imath::V2i(0, 0), Imath::V2i(win.display.x1 - 1, win.display.y1 - 1));
+    const Imath::Box2i dataWindow(Imath::V2i(win.data.x0, win.data.y0), Imath::V2i(win.data.x1 - 1, win.data.y1 - 1));
 
-    Imf::Header header(img.width, img.height);
+    Imf::Header header(displayWindow, dataWindow);
     header.compression() = Imf::ZIP_COMPRESSION;
     for (const char* name : RgbaNames) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
     for (const auto& [name, value] : attributes) {
@@ -223,12 +231,14 @@ void writeExr(const std::string& path, const Image& img, const StringAttributes&
         header.insert(name, Imf::StringAttribute(value));
     }
 
+    // Slices address pixels by their frame coordinates (Slice::Make offsets
+    // the base by the data window). OpenEXR's Slice wants a non-const base,
+    // but only reads through it when writing.
     const size_t xStride = 4 * sizeof(float), yStride = xStride * size_t(img.width);
-    // OpenEXR's Slice wants a non-const base, but only reads through it when writing.
-    char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgba.data()));
+    float* base = const_cast<float*>(img.rgba.data());
     Imf::FrameBuffer fb;
     for (int c = 0; c < 4; ++c)
-        fb.insert(RgbaNames[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xStride, yStride));
+        fb.insert(RgbaNames[c], Imf::Slice::Make(Imf::FLOAT, base + c, dataWindow, xStride, yStride));
 
     for (const ExrLayer& layer : layers) {
         const size_t n = layer.channels.size();
@@ -240,9 +250,9 @@ void writeExr(const std::string& path, const Image& img, const StringAttributes&
             if (header.channels().findChannel(name))
                 throw InputError(str("cannot write '", path, "': duplicate channel '", name, "'"));
             header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-            char* layerBase = reinterpret_cast<char*>(const_cast<float*>(layer.pixels.data()));
-            fb.insert(name, Imf::Slice(Imf::FLOAT, layerBase + c * sizeof(float), n * sizeof(float),
-                                       n * sizeof(float) * size_t(img.width)));
+            float* layerBase = const_cast<float*>(layer.pixels.data()) + c;
+            fb.insert(name, Imf::Slice::Make(Imf::FLOAT, layerBase, dataWindow, n * sizeof(float),
+                                             n * sizeof(float) * size_t(img.width)));
         }
     }
 
@@ -281,6 +291,55 @@ Image readExr(const std::string& path) {
         in.setFrameBuffer(fb);
         in.readPixels(dw.min.y, dw.max.y);
         return img;
+    });
+}
+
+ExrContents readExrContents(const std::string& path) {
+    return withInputFile(path, [&](Imf::InputFile& in) {
+        const Imath::Box2i dw = in.header().dataWindow(), dispw = in.header().displayWindow();
+        const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+        const int channels = channelCount(in);
+        std::error_code ec;
+        const uint64_t fileBytes = uint64_t(std::filesystem::file_size(path, ec));
+        checkDataWindowFits(path, w, h, channels, ec ? UINT64_MAX : fileBytes);
+        checkMemory(uint64_t(w) * uint64_t(h) * uint64_t(std::max(4, channels + 1)) * sizeof(float),
+                    str("'", path, "' (", w, "x", h, " pixels, ", channels, " channels)"));
+        const Imf::ChannelList& list = in.header().channels();
+        for (int c = 0; c < 3; ++c)
+            if (!list.findChannel(RgbaNames[c])) throw InputError(str("'", path, "' has no ", RgbaNames[c], " channel"));
+
+        ExrContents out;
+        out.window.data = {dw.min.x, dw.min.y, dw.max.x + 1, dw.max.y + 1};
+        out.window.display = {dispw.min.x, dispw.min.y, dispw.max.x + 1, dispw.max.y + 1};
+        out.image = Image(int(w), int(h));
+        Imf::FrameBuffer fb;
+        for (int c = 0; c < 4; ++c)
+            fb.insert(RgbaNames[c], Imf::Slice::Make(Imf::FLOAT, out.image.rgba.data() + c, dw, 4 * sizeof(float),
+                                                     4 * sizeof(float) * size_t(w), 1, 1, c == 3 ? 1.0 : 0.0));
+        // The other channels, grouped into layers by the name before the last '.'.
+        for (auto it = list.begin(); it != list.end(); ++it) {
+            const std::string name = it.name();
+            if (name == "R" || name == "G" || name == "B" || name == "A") continue;
+            const size_t dot = name.rfind('.');
+            const std::string layer = dot == std::string::npos ? std::string() : name.substr(0, dot);
+            const std::string channel = dot == std::string::npos ? name : name.substr(dot + 1);
+            if (out.layers.empty() || out.layers.back().name != layer) out.layers.push_back({layer, {}, {}});
+            out.layers.back().channels.push_back(channel);
+        }
+        for (ExrLayer& l : out.layers) {
+            const size_t n = l.channels.size();
+            l.pixels.assign(size_t(w) * size_t(h) * n, 0.f);
+            for (size_t c = 0; c < n; ++c)
+                fb.insert(l.name.empty() ? l.channels[c] : l.name + "." + l.channels[c],
+                          Imf::Slice::Make(Imf::FLOAT, l.pixels.data() + c, dw, n * sizeof(float),
+                                           n * sizeof(float) * size_t(w)));
+        }
+        in.setFrameBuffer(fb);
+        in.readPixels(dw.min.y, dw.max.y);
+        for (auto it = in.header().begin(); it != in.header().end(); ++it)
+            if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+                out.attributes.emplace_back(it.name(), s->value());
+        return out;
     });
 }
 

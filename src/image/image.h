@@ -10,6 +10,18 @@
 
 namespace vdbmarch {
 
+// A rectangle of pixels [x0, x1) x [y0, y1) of a frame, top row 0.
+struct PixelRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    bool empty() const { return x1 <= x0 || y1 <= y0; }
+    bool contains(const PixelRect& r) const { return r.x0 >= x0 && r.y0 >= y0 && r.x1 <= x1 && r.y1 <= y1; }
+    bool overlaps(const PixelRect& r) const { return r.x0 < x1 && x0 < r.x1 && r.y0 < y1 && y0 < r.y1; }
+    bool operator==(const PixelRect& r) const { return x0 == r.x0 && y0 == r.y0 && x1 == r.x1 && y1 == r.y1; }
+    bool operator!=(const PixelRect& r) const { return !(*this == r); }
+};
+
 struct Image {
     int width = 0, height = 0;
     std::vector<float> rgba;  // 4 floats per pixel, row-major, top row first

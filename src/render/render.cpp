@@ -117,6 +117,16 @@ std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const std:
 
 }  // namespace
 
+PixelRect tileOfFrame(int index, int count, int width, int height) {
+    if (count < 1 || count > height)
+        throw InputError(str("--tile ", index, "/", count, ": the frame is split into horizontal bands of rows, so the "
+                             "tile count must be 1 to the image height (", height, ")"));
+    if (index < 0 || index >= count)
+        throw InputError(str("--tile ", index, "/", count, ": the tile index must be 0 to ", count - 1));
+    auto row = [&](int i) { return int(int64_t(i) * height / count); };
+    return {0, row(index), width, row(index + 1)};
+}
+
 void checkImageMemory(int width, int height, const AovSet& aovs) {
     const uint64_t perPixel = sizeof(Color) + sizeof(double) + 4 * sizeof(float) + AovSums::bytesPerPixel(aovs);
     checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
@@ -126,16 +136,25 @@ void checkImageMemory(int width, int height, const AovSet& aovs) {
 RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const RenderSettings& rs = scene.desc.render;
     const int w = scene.camera->width(), h = scene.camera->height();
-    checkImageMemory(w, h, rs.aovs);
-    const int tilesX = (w + TileSize - 1) / TileSize, tilesY = (h + TileSize - 1) / TileSize;
+    const PixelRect frame{0, 0, w, h};
+    const PixelRect window = options.crop ? *options.crop : frame;
+    if (window.empty() || !frame.contains(window))
+        throw InputError(str("crop [", window.x0, ", ", window.x1, ") x [", window.y0, ", ", window.y1,
+                             ") is empty or not inside the ", w, "x", h, " frame"));
+    // Buffers hold the window's pixels; random streams are keyed by the
+    // pixel's index in the whole frame.
+    const int ww = window.width(), wh = window.height();
+    checkImageMemory(ww, wh, rs.aovs);
+    const int tilesX = (ww + TileSize - 1) / TileSize, tilesY = (wh + TileSize - 1) / TileSize;
     const int tiles = tilesX * tilesY;
     const bool timed = options.timeBudget > 0;
     RenderResult result;
-    result.image = Image(w, h);
-    std::vector<Color> sums(size_t(w) * size_t(h), Color(0));
-    std::vector<double> transmittances(size_t(w) * size_t(h), 0.0);
+    result.image = Image(ww, wh);
+    result.window = window;
+    std::vector<Color> sums(size_t(ww) * size_t(wh), Color(0));
+    std::vector<double> transmittances(size_t(ww) * size_t(wh), 0.0);
     const AovSet& aovs = rs.aovs;
-    AovSums aovSums(aovs, size_t(w) * size_t(h));
+    AovSums aovSums(aovs, size_t(ww) * size_t(wh));
     std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
     ProgressBar progress(options.progress, timed ? 1000 : tiles);
     const int threads = resolveThreadCount(rs.threads);
@@ -165,12 +184,13 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
                 for (int tile = range.begin(); tile != range.end(); ++tile) {
                     ThreadContext ctx(scene);
-                    const int x0 = (tile % tilesX) * TileSize, y0 = (tile / tilesX) * TileSize;
-                    for (int y = y0; y < std::min(y0 + TileSize, h); ++y)
-                        for (int x = x0; x < std::min(x0 + TileSize, w); ++x) {
-                            const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);
-                            Color& sum = sums[pixel];
-                            double& transmittance = transmittances[pixel];
+                    const int x0 = window.x0 + (tile % tilesX) * TileSize, y0 = window.y0 + (tile / tilesX) * TileSize;
+                    for (int y = y0; y < std::min(y0 + TileSize, window.y1); ++y)
+                        for (int x = x0; x < std::min(x0 + TileSize, window.x1); ++x) {
+                            const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
+                            const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
+                            Color& sum = sums[local];
+                            double& transmittance = transmittances[local];
                             for (int s = s0; s < s1; ++s) {
                                 Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
                                 float jx = 0.5f, jy = 0.5f;
@@ -187,16 +207,16 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                                 sum += pr.L;
                                 transmittance += pr.transmittance;
                                 if (aovs.any()) {
-                                    if (aovs.splitDirect()) aovSums.direct[pixel] += pr.direct;
+                                    if (aovs.splitDirect()) aovSums.direct[local] += pr.direct;
                                     if (aovs.firstEvent()) {
                                         Rng aovRng(hashValues(rs.seed, pixel, AovStream), uint64_t(s));
                                         const FirstEvent fe = traceFirstEvent(ctx, ray, aovRng);
                                         if (aovs.depth && fe.hasDepth) {
-                                            aovSums.depth[pixel] += double(scene.camera->viewDepth(fe.depthPoint));
-                                            ++aovSums.depthSamples[pixel];
+                                            aovSums.depth[local] += double(scene.camera->viewDepth(fe.depthPoint));
+                                            ++aovSums.depthSamples[local];
                                         }
-                                        if (aovs.albedo) aovSums.albedo[pixel] += fe.albedo;
-                                        if (aovs.normal) aovSums.normal[pixel] += fe.normal;
+                                        if (aovs.albedo) aovSums.albedo[local] += fe.albedo;
+                                        if (aovs.normal) aovSums.normal[local] += fe.normal;
                                     }
                                 }
                             }
@@ -258,9 +278,9 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     result.photons = illumination->stats.photons;
     result.photonPasses = illumination->pass + 1;
     const float inv = 1.f / float(spp);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            size_t pixel = size_t(y) * size_t(w) + size_t(x);
+    for (int y = 0; y < wh; ++y)
+        for (int x = 0; x < ww; ++x) {
+            size_t pixel = size_t(y) * size_t(ww) + size_t(x);
             result.image.set(x, y, sums[pixel] * inv, clamp(1.f - float(transmittances[pixel]) * inv, 0.f, 1.f));
         }
     result.layers = aovLayers(aovs, aovSums, sums, spp);

@@ -22,10 +22,16 @@ struct RenderOptions {
     double timeBudget = 0;
     std::optional<std::chrono::steady_clock::time_point> runStart;
     IlluminationOptions illumination;  // a baked cache to load (render --cache)
+    // Render only these pixels of the frame (render --tile / --crop). Every
+    // pixel gets exactly the samples it gets in a whole-frame render, and
+    // the photons and cache are those of the whole frame, so a tile is
+    // bit-identical to its part of the whole render.
+    std::optional<PixelRect> crop;
 };
 
 struct RenderResult {
-    Image image;
+    Image image;          // the pixels of `window` (the whole frame unless cropped)
+    PixelRect window;
     RenderCounters counters;
     double seconds = 0;   // photons, cache and rendering
     double illuminationSeconds = 0;  // photon tracing and cache (part of seconds)
@@ -46,6 +52,12 @@ constexpr float NoDepth = 1e10f;
 // not fit in this machine's memory: per pixel the RGB sum, the transmittance
 // sum and the RGBA result, and the sums and layers of the AOVs.
 void checkImageMemory(int width, int height, const AovSet& aovs = {});
+
+// Tile `index` of `count` of a width x height frame: horizontal bands of
+// whole rows (the unit an EXR scanline file stores), rows
+// [floor(index h / count), floor((index + 1) h / count)). InputError when
+// count is not in [1, height] or index not in [0, count).
+PixelRect tileOfFrame(int index, int count, int width, int height);
 
 // Renders the scene with scene.desc.render's method, spp, seed and threads.
 // Deterministic: each pixel sample has its own random stream, so the image is

@@ -1,0 +1,259 @@
+#include "app/tiles.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "core/hash.h"
+#include "core/memory.h"
+#include "render/render.h"
+
+namespace vdbmarch {
+
+TileRequest parseTileRequest(const std::string& tile, const std::string& crop) {
+    TileRequest r;
+    if (!tile.empty() && !crop.empty())
+        throw InputError(str("--tile ", tile, " and --crop ", crop, " both given: a render covers one part of the frame"));
+    char extra = 0;
+    if (!tile.empty()) {
+        if (std::sscanf(tile.c_str(), "%d/%d%c", &r.index, &r.count, &extra) != 2)
+            throw InputError(str("--tile ", tile, ": expected INDEX/COUNT with a 0-based index, e.g. 0/4"));
+        if (r.count < 1) throw InputError(str("--tile ", tile, ": the tile count must be at least 1"));
+        if (r.index < 0 || r.index >= r.count)
+            throw InputError(str("--tile ", tile, ": the tile index must be 0 to ", r.count - 1, " (0-based)"));
+    }
+    if (!crop.empty()) {
+        PixelRect& c = r.crop;
+        if (std::sscanf(crop.c_str(), "%d,%d,%d,%d%c", &c.x0, &c.y0, &c.x1, &c.y1, &extra) != 4)
+            throw InputError(str("--crop ", crop, ": expected x0,y0,x1,y1 in pixels (x1, y1 excluded), e.g. 0,0,320,240"));
+        if (c.empty())
+            throw InputError(str("--crop ", crop, ": empty; x0 < x1 and y0 < y1 are needed (x1, y1 excluded)"));
+        r.cropped = true;
+    }
+    return r;
+}
+
+PixelRect windowOf(const TileRequest& r, int width, int height) {
+    if (r.count > 0) return tileOfFrame(r.index, r.count, width, height);
+    if (!r.cropped) return {0, 0, width, height};
+    if (!PixelRect{0, 0, width, height}.contains(r.crop))
+        throw InputError(str("--crop ", r.crop.x0, ",", r.crop.y0, ",", r.crop.x1, ",", r.crop.y1,
+                             ": not inside the ", width, "x", height, " frame (0 <= x0 < x1 <= ", width,
+                             ", 0 <= y0 < y1 <= ", height, ")"));
+    return r.crop;
+}
+
+StringAttributes tileAttributes(const TileRequest& r) {
+    if (r.count > 0) return {{TileSplitAttribute, str(r.count, " bands")}, {TileAttribute, str(r.index, "/", r.count)}};
+    if (r.cropped)
+        return {{TileSplitAttribute, "crop"},
+                {TileAttribute, str(r.crop.x0, ",", r.crop.y0, ",", r.crop.x1, ",", r.crop.y1)}};
+    return {};
+}
+
+std::string renderHash(const SceneDesc& desc, const std::string& cacheFile) {
+    nlohmann::json j = nlohmann::json::parse(desc.jsonText);
+    if (j.contains("render") && j["render"].is_object()) j["render"].erase("threads");
+    Fnv1a h;
+    const std::string text = j.dump() + "\n" + VDBMARCH_VERSION + "\n" + cacheFile;
+    h.add(text.data(), text.size());
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h.value));
+    return buf;
+}
+
+namespace {
+
+struct Tile {
+    std::string path;
+    ExrContents contents;
+    std::map<std::string, std::string> attributes;
+    int index = -1, count = 0;  // of a band split
+    const std::string& attribute(const std::string& name) const {
+        static const std::string none = "(none)";
+        auto it = attributes.find(name);
+        return it == attributes.end() ? none : it->second;
+    }
+};
+
+// Attributes that differ between the tiles of one render: the tile itself,
+// its time, and the effective scene text (which records render.threads;
+// vdbmarch:renderHash stands for the rest of it).
+bool perTileAttribute(const std::string& name, bool timed) {
+    static const std::set<std::string> always = {TileAttribute, "vdbmarch:renderSeconds", "vdbmarch:scene"};
+    // A tile given a time budget renders as many samples as fit.
+    static const std::set<std::string> timedOnly = {"vdbmarch:spp", "vdbmarch:photonPasses"};
+    return always.count(name) || (timed && timedOnly.count(name));
+}
+
+std::string describe(const PixelRect& r) {
+    return str("[", r.x0, ", ", r.x1, ") x [", r.y0, ", ", r.y1, ")");
+}
+
+// "4-16", or "16" when all agree.
+std::string valueRange(const std::vector<Tile>& tiles, const std::string& name) {
+    int lo = 0, hi = 0;
+    bool first = true;
+    for (const Tile& t : tiles) {
+        const int v = std::atoi(t.attribute(name).c_str());
+        lo = first ? v : std::min(lo, v);
+        hi = first ? v : std::max(hi, v);
+        first = false;
+    }
+    return lo == hi ? str(lo) : str(lo, "-", hi);
+}
+
+}  // namespace
+
+MergedTiles mergeTiles(const std::vector<std::string>& paths) {
+    if (paths.empty()) throw InputError("merge: no tiles given");
+    std::vector<Tile> tiles;
+    tiles.reserve(paths.size());
+    for (const std::string& path : paths) {
+        Tile t;
+        t.path = path;
+        t.contents = readExrContents(path);
+        for (const auto& [k, v] : t.contents.attributes) t.attributes[k] = v;
+        if (!t.attributes.count(TileSplitAttribute) || !t.attributes.count(TileAttribute))
+            throw InputError(str(path, ": not a vdbmarch tile (no ", TileSplitAttribute,
+                                 " attribute): render tiles with --tile I/N or --crop"));
+        const std::string& split = t.attribute(TileSplitAttribute);
+        if (split != "crop") {
+            char extra = 0;
+            if (std::sscanf(t.attribute(TileAttribute).c_str(), "%d/%d%c", &t.index, &t.count, &extra) != 2 ||
+                split != str(t.count, " bands") || t.index < 0 || t.index >= t.count)
+                throw InputError(str(path, ": damaged tile header: ", TileSplitAttribute, " = \"", split, "\", ",
+                                     TileAttribute, " = \"", t.attribute(TileAttribute), "\""));
+        }
+        tiles.push_back(std::move(t));
+    }
+
+    // Every tile against the first: the same split, frame, scene and
+    // settings (any vdbmarch:* attribute but the per-tile ones).
+    const Tile& ref = tiles.front();
+    const bool timed = ref.attribute("vdbmarch:timeBudget") != "none";
+    // The split and frame first, the named settings next, the hash of the
+    // rest of the scene last, so the message names the most telling one.
+    std::vector<std::string> keys = {TileSplitAttribute, "vdbmarch:frame"};
+    std::set<std::string> named;
+    for (const Tile& t : tiles)
+        for (const auto& kv : t.attributes)
+            if (kv.first.rfind("vdbmarch:", 0) == 0 && kv.first != RenderHashAttribute &&
+                std::find(keys.begin(), keys.end(), kv.first) == keys.end())
+                named.insert(kv.first);
+    keys.insert(keys.end(), named.begin(), named.end());
+    keys.push_back(RenderHashAttribute);
+    for (const Tile& t : tiles) {
+        if (&t == &ref) continue;
+        for (const std::string& k : keys) {
+            if (perTileAttribute(k, timed) || t.attribute(k) == ref.attribute(k)) continue;
+            throw InputError(str(t.path, ": belongs to another render than ", ref.path, ": ", k, " is \"",
+                                 printableExcerpt(t.attribute(k)), "\" there and \"", printableExcerpt(ref.attribute(k)),
+                                 "\" in ", ref.path,
+                                 k == RenderHashAttribute ? " (another scene, settings, version or cache)" : ""));
+        }
+        if (t.contents.window.display != ref.contents.window.display)
+            throw InputError(str(t.path, ": belongs to another render than ", ref.path, ": its frame is ",
+                                 t.contents.window.display.width(), "x", t.contents.window.display.height(), ", not ",
+                                 ref.contents.window.display.width(), "x", ref.contents.window.display.height()));
+        bool sameLayers = t.contents.layers.size() == ref.contents.layers.size();
+        for (size_t i = 0; sameLayers && i < t.contents.layers.size(); ++i)
+            sameLayers = t.contents.layers[i].name == ref.contents.layers[i].name &&
+                         t.contents.layers[i].channels == ref.contents.layers[i].channels;
+        if (!sameLayers)
+            throw InputError(str(t.path, ": belongs to another render than ", ref.path, ": its AOV layers differ"));
+    }
+
+    const PixelRect frame = ref.contents.window.display;
+    for (const Tile& t : tiles) {
+        const PixelRect& d = t.contents.window.data;
+        if (frame.x0 != 0 || frame.y0 != 0 || !frame.contains(d))
+            throw InputError(str(t.path, ": damaged tile: its data window ", describe(d), " is not inside the frame ",
+                                 describe(frame)));
+        if (t.count > 0 && d != tileOfFrame(t.index, t.count, frame.width(), frame.height()))
+            throw InputError(str(t.path, ": damaged tile: tile ", t.index, "/", t.count, " should cover ",
+                                 describe(tileOfFrame(t.index, t.count, frame.width(), frame.height())), ", not ",
+                                 describe(d)));
+    }
+    // Duplicates and overlaps, then holes.
+    for (size_t i = 0; i < tiles.size(); ++i)
+        for (size_t j = i + 1; j < tiles.size(); ++j) {
+            const Tile &a = tiles[i], &b = tiles[j];
+            if (a.count > 0 && a.index == b.index)
+                throw InputError(str("tile ", a.index, "/", a.count, " is given twice: ", a.path, " and ", b.path));
+            if (a.contents.window.data.overlaps(b.contents.window.data))
+                throw InputError(str(a.path, " and ", b.path, " overlap: ", describe(a.contents.window.data), " and ",
+                                     describe(b.contents.window.data)));
+        }
+    uint64_t covered = 0;
+    for (const Tile& t : tiles) covered += uint64_t(t.contents.image.pixelCount());
+    const uint64_t framePixels = uint64_t(frame.width()) * uint64_t(frame.height());
+    if (covered != framePixels) {
+        if (ref.count > 0) {
+            std::vector<bool> present(size_t(ref.count), false);
+            for (const Tile& t : tiles) present[size_t(t.index)] = true;
+            std::string missing;
+            int n = 0;
+            for (int i = 0; i < ref.count; ++i)
+                if (!present[size_t(i)]) {
+                    const PixelRect r = tileOfFrame(i, ref.count, frame.width(), frame.height());
+                    if (n < 8) missing += str(n ? ", " : "", i, "/", ref.count, " (rows ", r.y0, "-", r.y1 - 1, ")");
+                    ++n;
+                }
+            throw InputError(str("merge: ", n, " of ", ref.count, " tiles missing: ", missing, n > 8 ? ", ..." : "",
+                                 "; nothing written"));
+        }
+        checkMemory(framePixels, "the coverage map of the frame");
+        std::vector<char> hit(framePixels, 0);
+        for (const Tile& t : tiles) {
+            const PixelRect& d = t.contents.window.data;
+            for (int y = d.y0; y < d.y1; ++y)
+                std::fill_n(hit.begin() + int64_t(y) * frame.width() + d.x0, d.width(), 1);
+        }
+        const size_t hole = size_t(std::find(hit.begin(), hit.end(), 0) - hit.begin());
+        throw InputError(str("merge: the crops cover ", covered, " of the ", framePixels, " pixels of the ",
+                             frame.width(), "x", frame.height(), " frame; the first hole is at pixel (",
+                             hole % size_t(frame.width()), ", ", hole / size_t(frame.width()), "); nothing written"));
+    }
+
+    // Assemble: RGBA and every layer, row by row.
+    size_t floatsPerPixel = 4;
+    for (const ExrLayer& l : ref.contents.layers) floatsPerPixel += l.channels.size();
+    checkMemory(framePixels * floatsPerPixel * sizeof(float), str("the merged ", frame.width(), "x", frame.height(), " frame"));
+    MergedTiles out;
+    ExrContents& m = out.frame;
+    m.image = Image(frame.width(), frame.height());
+    m.window = {frame, frame};
+    for (const ExrLayer& l : ref.contents.layers)
+        m.layers.push_back({l.name, l.channels, std::vector<float>(framePixels * l.channels.size())});
+    double seconds = 0;
+    for (const Tile& t : tiles) {
+        const PixelRect& d = t.contents.window.data;
+        auto copyRows = [&](const std::vector<float>& from, std::vector<float>& to, size_t n) {
+            for (int y = d.y0; y < d.y1; ++y)
+                std::copy_n(from.begin() + int64_t(y - d.y0) * d.width() * int64_t(n), size_t(d.width()) * n,
+                            to.begin() + (int64_t(y) * frame.width() + d.x0) * int64_t(n));
+        };
+        copyRows(t.contents.image.rgba, m.image.rgba, 4);
+        for (size_t i = 0; i < m.layers.size(); ++i)
+            copyRows(t.contents.layers[i].pixels, m.layers[i].pixels, m.layers[i].channels.size());
+        seconds += std::atof(t.attribute("vdbmarch:renderSeconds").c_str());
+    }
+    for (const auto& [k, v] : ref.contents.attributes) {
+        if (k == TileSplitAttribute || k == TileAttribute) continue;
+        if (k == "vdbmarch:renderSeconds") m.attributes.emplace_back(k, str(seconds));
+        else if (timed && (k == "vdbmarch:spp" || k == "vdbmarch:photonPasses"))
+            m.attributes.emplace_back(k, valueRange(tiles, k));
+        else m.attributes.emplace_back(k, v);
+    }
+    m.attributes.emplace_back("vdbmarch:mergedFrom", str(tiles.size(), " tiles (", ref.attribute(TileSplitAttribute), ")"));
+    if (timed && valueRange(tiles, "vdbmarch:spp").find('-') != std::string::npos)
+        out.warnings.push_back(str("the tiles were rendered with a time budget and reached ", valueRange(tiles, "vdbmarch:spp"),
+                                   " samples per pixel: noise (and, with photons, bias) may differ between tiles"));
+    return out;
+}
+
+}  // namespace vdbmarch

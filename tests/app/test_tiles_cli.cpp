@@ -1,0 +1,154 @@
+// `render --tile / --crop` and `merge` through the command (docs/farm.md):
+// tiles merged in any order are bit-identical to a one-process render
+// (`compare --identical`), and merge refuses, naming the file, a missing,
+// duplicate, overlapping, foreign or non-tile input, writing nothing and
+// leaving an existing output as it was.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "image/exr_io.h"
+#include "support/support.h"
+
+namespace vdbmarch {
+namespace {
+
+using namespace test;
+
+class TilesCli : public BadInput {
+protected:
+    // Renders the sample cloud at 48x36, 3 spp, 2 threads (unless `extra`
+    // gives --res or --threads) with the `extra` options to `out`.
+    void render(const std::string& out, std::vector<std::string> extra = {}) {
+        std::vector<std::string> args = {"render", samplePath("cloud.json"), "--spp", "3", "-q", "-o", out};
+        auto given = [&](const char* o) { return std::find(extra.begin(), extra.end(), o) != extra.end(); };
+        if (!given("--res")) args.insert(args.end(), {"--res", "48x36"});
+        if (!given("--threads")) args.insert(args.end(), {"--threads", "2"});
+        args.insert(args.end(), extra.begin(), extra.end());
+        const CliResult r = cli(args);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+    }
+    void renderTiles(int n, const std::vector<std::string>& extra = {}) {
+        for (int i = 0; i < n; ++i) {
+            std::vector<std::string> e = {"--tile", str(i, "/", n)};
+            e.insert(e.end(), extra.begin(), extra.end());
+            render(str("t", i, ".exr"), e);
+        }
+    }
+    CliResult merge(std::vector<std::string> tiles, const std::string& out = "merged.exr") {
+        tiles.insert(tiles.begin(), "merge");
+        tiles.insert(tiles.end(), {"-o", out, "-q"});
+        return cli(tiles);
+    }
+    CliResult identical(const std::string& a, const std::string& b) { return cli({"compare", a, b, "--identical"}); }
+};
+
+TEST_F(TilesCli, MergedTilesAreBitIdenticalToOneProcess) {
+    render("single.exr", {"--aovs", "depth,albedo,direct,indirect"});
+    renderTiles(4, {"--aovs", "depth,albedo,direct,indirect", "--threads", "1"});
+    const ExrContents tile = readExrContents(work("t1.exr"));
+    EXPECT_EQ(tile.window.display, (PixelRect{0, 0, 48, 36}));
+    EXPECT_EQ(tile.window.data, (PixelRect{0, 9, 48, 18}));
+    const CliResult m = merge({"t2.exr", "t0.exr", "t3.exr", "t1.exr"});  // any order
+    ASSERT_EQ(m.exitCode, 0) << m.err;
+    const CliResult same = identical("merged.exr", "single.exr");
+    EXPECT_EQ(same.exitCode, 0) << same.out;
+    EXPECT_NE(same.out.find("identical yes"), std::string::npos) << same.out;
+    // The header keeps the render's settings, without the tile's own.
+    bool tileAttr = false, merged = false;
+    for (const auto& [k, v] : readExrStringAttributes(work("merged.exr"))) {
+        tileAttr |= k == "vdbmarch:tile";
+        merged |= k == "vdbmarch:mergedFrom" && v == "4 tiles (4 bands)";
+    }
+    EXPECT_FALSE(tileAttr);
+    EXPECT_TRUE(merged);
+}
+
+TEST_F(TilesCli, CropsThatCoverTheFrameMerge) {
+    render("single.exr");
+    render("a.exr", {"--crop", "0,0,20,36"});
+    render("b.exr", {"--crop", "20,0,48,10"});
+    render("c.exr", {"--crop", "20,10,48,36"});
+    ASSERT_EQ(merge({"a.exr", "b.exr", "c.exr"}).exitCode, 0);
+    EXPECT_EQ(identical("merged.exr", "single.exr").exitCode, 0);
+}
+
+TEST_F(TilesCli, IdenticalSeesOneChangedPixel) {
+    render("a.exr");
+    render("b.exr", {"--seed", "8"});
+    const CliResult r = identical("a.exr", "b.exr");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.out.find("identical no"), std::string::npos) << r.out;
+    render("c.exr", {"--crop", "0,0,48,18"});
+    EXPECT_EQ(identical("a.exr", "c.exr").exitCode, 1);  // the windows differ
+}
+
+TEST_F(TilesCli, MissingDuplicateAndForeignTilesAreNamedAndNothingIsWritten) {
+    renderTiles(3);
+    writeText(work("merged.exr"), "keep me");
+    expectCliError(merge({"t0.exr", "t2.exr"}), {"1 of 3 tiles missing", "1/3", "rows 12-23", "nothing written"});
+    expectCliError(merge({"t0.exr", "t1.exr", "t1.exr", "t2.exr"}), {"tile 1/3 is given twice", "t1.exr"});
+    render("seed.exr", {"--tile", "1/3", "--seed", "5"});
+    expectCliError(merge({"t0.exr", "seed.exr", "t2.exr"}), {"seed.exr", "t0.exr", "vdbmarch:seed", "\"5\"", "\"1\""});
+    render("split.exr", {"--tile", "1/4"});
+    expectCliError(merge({"t0.exr", "split.exr", "t2.exr"}), {"split.exr", "vdbmarch:split", "4 bands", "3 bands"});
+    render("res.exr", {"--tile", "1/3", "--res", "50x36"});
+    expectCliError(merge({"t0.exr", "res.exr", "t2.exr"}), {"res.exr", "t0.exr"});
+    render("whole.exr");
+    expectCliError(merge({"t0.exr", "whole.exr"}), {"whole.exr", "not a vdbmarch tile"});
+    expectCliError(merge({"t0.exr", "t1.exr", "nope.exr"}), {"nope.exr"});
+    EXPECT_EQ(readBytes(work("merged.exr")), "keep me");
+    EXPECT_TRUE(tempLeftovers(mWork).empty());
+}
+
+TEST_F(TilesCli, OverlapsAndHolesAreNamed) {
+    render("a.exr", {"--crop", "0,0,30,36"});
+    render("b.exr", {"--crop", "20,0,48,36"});
+    expectCliError(merge({"a.exr", "b.exr"}), {"a.exr and b.exr overlap", "[20, 48)"});
+    render("c.exr", {"--crop", "30,0,48,20"});
+    expectCliError(merge({"a.exr", "c.exr"}), {"the first hole is at pixel (30, 20)", "nothing written"});
+    EXPECT_FALSE(fs::exists(work("merged.exr")));
+}
+
+TEST_F(TilesCli, BadTileOptionsAreRefusedBeforeRendering) {
+    const std::string s = samplePath("cloud.json");
+    expectCliError(cli({"render", s, "-o", "o.exr", "--tile", "4/4"}), {"--tile 4/4", "0 to 3"});
+    expectCliError(cli({"render", s, "-o", "o.exr", "--tile", "two"}), {"--tile two", "INDEX/COUNT"});
+    expectCliError(cli({"render", s, "-o", "o.exr", "--tile", "0/500", "--res", "64x48"}),
+                   {"--tile 0/500", "image height (48)"});
+    expectCliError(cli({"render", s, "-o", "o.exr", "--crop", "0,0,65,10", "--res", "64x48"}),
+                   {"--crop 0,0,65,10", "64x48"});
+    expectCliError(cli({"render", s, "-o", "o.exr", "--crop", "5,0,5,10"}), {"--crop 5,0,5,10", "empty"});
+    expectCliError(cli({"render", s, "-o", "o.exr", "--crop", "0,0,1,1", "--tile", "0/2"}), {"--tile 0/2", "--crop"});
+    EXPECT_FALSE(fs::exists(work("o.exr")));
+}
+
+// A tile given --time renders the samples that fit its own budget; merge
+// accepts timed tiles whose sample counts differ, records their range and
+// warns when they differ.
+TEST_F(TilesCli, TimedTilesMergeWithTheirSampleRange) {
+    auto attribute = [&](const std::string& file, const std::string& name) {
+        for (const auto& [k, v] : readExrStringAttributes(work(file)))
+            if (k == name) return v;
+        return std::string();
+    };
+    for (int i = 0; i < 2; ++i) {
+        const CliResult r = cli({"render", samplePath("cloud.json"), "--res", "48x36", "--time", "0.6", "--tile",
+                                 str(i, "/2"), "-q", "-o", str("t", i, ".exr")});
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+    }
+    const CliResult m = cli({"merge", "t0.exr", "t1.exr", "-o", "merged.exr"});
+    ASSERT_EQ(m.exitCode, 0) << m.err;
+    const int a = std::stoi(attribute("t0.exr", "vdbmarch:spp")), b = std::stoi(attribute("t1.exr", "vdbmarch:spp"));
+    const std::string expected = a == b ? str(a) : str(std::min(a, b), "-", std::max(a, b));
+    EXPECT_EQ(attribute("merged.exr", "vdbmarch:spp"), expected);
+    EXPECT_EQ(m.err.find("time budget") != std::string::npos, a != b) << m.err;
+    // Another budget is another render.
+    const CliResult other = cli({"render", samplePath("cloud.json"), "--res", "48x36", "--time", "0.4", "--tile", "1/2",
+                                 "-q", "-o", "t1b.exr"});
+    ASSERT_EQ(other.exitCode, 0) << other.err;
+    expectCliError(merge({"t0.exr", "t1b.exr"}), {"t1b.exr", "vdbmarch:timeBudget"});
+}
+
+}  // namespace
+}  // namespace vdbmarch
