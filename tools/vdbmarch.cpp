@@ -70,6 +70,9 @@ int main(int argc, char** argv) {
                        "Render tile I of N (0-based) of a fixed split of the frame into N bands of rows; the EXR's "
                        "data window is the tile (vdbmarch merge assembles tiles)");
     render->add_option("--crop", ra.crop, "Render only pixels [x0, x1) x [y0, y1) of the frame: x0,y0,x1,y1");
+    render->add_option("--passes", ra.passes,
+                       "Render only the camera samples of photon passes FIRST to END-1 (FIRST-END) of a progressive "
+                       "render, keeping each pass's sums for merge");
     render->add_flag("--preview", ra.preview,
                      "A quick look: half the resolution, an eighth of the samples (or of --time), a quarter of the photons");
 

@@ -84,7 +84,7 @@ void validate(const RenderArgs& a) {
         throw InputError(str("--time ", *a.timeBudget, ": must be a positive number of seconds"));
     if (a.timeBudget && a.spp)
         throw InputError("--time and --spp both given: a render is budgeted either by samples or by seconds");
-    parseTileRequest(a.tile, a.crop);
+    parseTileRequest(a.tile, a.crop, a.passes);
 }
 
 // Timings, counts and counters of a finished render (--stats).
@@ -136,7 +136,7 @@ int runRender(const RenderArgs& a) {
         overrides.insert(overrides.end(), p.begin(), p.end());
         desc = loadSceneInput(a.input, overrides);
     }
-    const TileRequest tile = parseTileRequest(a.tile, a.crop);
+    const TileRequest tile = parseTileRequest(a.tile, a.crop, a.passes);
     const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
     checkImageMemory(window.width(), window.height(), desc.render.aovs);  // before any volume is loaded
     std::unique_ptr<Scene> scene = buildScene(desc);
@@ -150,7 +150,8 @@ int runRender(const RenderArgs& a) {
         options.timeBudget = a.preview ? *a.timeBudget / 8 : *a.timeBudget;
         options.runStart = t0;
     }
-    if (tile.any()) options.crop = window;
+    if (tile.count > 0 || tile.cropped) options.crop = window;
+    if (tile.byPasses()) options.passes = std::make_pair(tile.firstPass, tile.endPass);
     RenderResult r = renderImage(*scene, options);
     if (r.counters.nonFiniteSamples > 0)
         warn(str(r.counters.nonFiniteSamples, " path sample(s) gave NaN or Inf and were dropped"));
@@ -170,7 +171,8 @@ int runRender(const RenderArgs& a) {
         {RenderHashAttribute, renderHash(desc, a.cache)},
     };
     if (!a.cache.empty()) attrs.emplace_back("vdbmarch:cache", a.cache);
-    for (auto& kv : tileAttributes(tile)) attrs.push_back(std::move(kv));
+    for (auto& kv : tileAttributes(tile, r)) attrs.push_back(std::move(kv));
+    if (tile.byPasses()) r.layers = passLayers(r);
     writeExr(a.output, r.image, attrs, r.layers,
              ExrWindow{r.window, PixelRect{0, 0, scene->camera->width(), scene->camera->height()}});
     if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
@@ -180,7 +182,8 @@ int runRender(const RenderArgs& a) {
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
                      tile.count > 0 ? str("tile ", tile.index, "/", tile.count, " (rows ", r.window.y0, "-", r.window.y1 - 1, ") of ").c_str()
-                     : tile.cropped ? str("crop ", a.crop, " of ").c_str() : "",
+                     : tile.cropped ? str("crop ", a.crop, " of ").c_str()
+                     : tile.byPasses() ? str("photon passes ", a.passes, " (samples ", r.firstSample, "-", r.firstSample + r.spp - 1, ") of ").c_str() : "",
                      scene->camera->width(), scene->camera->height(), r.spp, methodLabel(desc.render).c_str(), double(scene->step),
                      r.seconds,
                      r.illuminationSeconds > 0

@@ -12,7 +12,7 @@ namespace vdbmarch {
 
 struct RenderArgs {
     std::string input, output, png, res, stats, saveScene, cache;
-    std::string tile, crop;  // --tile I/N, --crop x0,y0,x1,y1 (app/tiles.h)
+    std::string tile, crop, passes;  // --tile I/N, --crop x0,y0,x1,y1, --passes FIRST-END (app/tiles.h)
     bool force = false, quiet = false, noProgress = false;
     bool preview = false;  // --preview: a quick look (previewOverrides in render_command.cpp)
     std::optional<double> timeBudget;  // --time

@@ -7,17 +7,26 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/command_line.h"
 #include "core/hash.h"
 #include "core/memory.h"
 #include "render/render.h"
 
 namespace vdbmarch {
 
-TileRequest parseTileRequest(const std::string& tile, const std::string& crop) {
+TileRequest parseTileRequest(const std::string& tile, const std::string& crop, const std::string& passes) {
     TileRequest r;
-    if (!tile.empty() && !crop.empty())
-        throw InputError(str("--tile ", tile, " and --crop ", crop, " both given: a render covers one part of the frame"));
+    if (int(!tile.empty()) + int(!crop.empty()) + int(!passes.empty()) > 1)
+        throw InputError(str(tile.empty() ? "" : str("--tile ", tile, " "), crop.empty() ? "" : str("--crop ", crop, " "),
+                             passes.empty() ? "" : str("--passes ", passes, " "),
+                             "given together: a render is split one way, by tiles, by a crop or by passes"));
     char extra = 0;
+    if (!passes.empty()) {
+        if (std::sscanf(passes.c_str(), "%d-%d%c", &r.firstPass, &r.endPass, &extra) != 2 || r.firstPass < 0 ||
+            r.endPass <= r.firstPass)
+            throw InputError(str("--passes ", passes, ": expected FIRST-END, photon passes FIRST to END-1 (0-based), "
+                                 "e.g. 0-4"));
+    }
     if (!tile.empty()) {
         if (std::sscanf(tile.c_str(), "%d/%d%c", &r.index, &r.count, &extra) != 2)
             throw InputError(str("--tile ", tile, ": expected INDEX/COUNT with a 0-based index, e.g. 0/4"));
@@ -46,12 +55,30 @@ PixelRect windowOf(const TileRequest& r, int width, int height) {
     return r.crop;
 }
 
-StringAttributes tileAttributes(const TileRequest& r) {
+StringAttributes tileAttributes(const TileRequest& r, const RenderResult& result) {
+    if (r.byPasses()) {
+        std::string samples;
+        for (const PassSums& p : result.passSums) samples += str(samples.empty() ? "" : ",", p.pass, ":", p.samples);
+        return {{TileSplitAttribute, str(result.totalPhotonPasses, " passes")},
+                {TileAttribute, str(r.firstPass, "-", r.endPass)},
+                {PassSamplesAttribute, samples}};
+    }
     if (r.count > 0) return {{TileSplitAttribute, str(r.count, " bands")}, {TileAttribute, str(r.index, "/", r.count)}};
     if (r.cropped)
         return {{TileSplitAttribute, "crop"},
                 {TileAttribute, str(r.crop.x0, ",", r.crop.y0, ",", r.crop.x1, ",", r.crop.y1)}};
     return {};
+}
+
+std::vector<ExrLayer> passLayers(const RenderResult& result) {
+    std::vector<ExrLayer> layers;
+    for (const PassSums& p : result.passSums) {
+        ExrLayer l{str("pass", p.pass), {"R", "G", "B", "T"}, {}};
+        l.pixels.reserve(p.L.size() * 4);
+        for (size_t i = 0; i < p.L.size(); ++i) l.pixels.insert(l.pixels.end(), {p.L[i].x, p.L[i].y, p.L[i].z, p.T[i]});
+        layers.push_back(std::move(l));
+    }
+    return layers;
 }
 
 std::string renderHash(const SceneDesc& desc, const std::string& cacheFile) {
@@ -72,6 +99,8 @@ struct Tile {
     ExrContents contents;
     std::map<std::string, std::string> attributes;
     int index = -1, count = 0;  // of a band split
+    int firstPass = -1, endPass = -1;          // of a split by passes
+    std::vector<std::pair<int, int>> samples;  // (pass, samples) of a split by passes
     const std::string& attribute(const std::string& name) const {
         static const std::string none = "(none)";
         auto it = attributes.find(name);
@@ -79,18 +108,97 @@ struct Tile {
     }
 };
 
+std::string describe(const PixelRect& r) {
+    return str("[", r.x0, ", ", r.x1, ") x [", r.y0, ", ", r.y1, ")");
+}
+
 // Attributes that differ between the tiles of one render: the tile itself,
 // its time, and the effective scene text (which records render.threads;
 // vdbmarch:renderHash stands for the rest of it).
-bool perTileAttribute(const std::string& name, bool timed) {
+bool perTileAttribute(const std::string& name, bool timed, bool byPasses) {
     static const std::set<std::string> always = {TileAttribute, "vdbmarch:renderSeconds", "vdbmarch:scene"};
-    // A tile given a time budget renders as many samples as fit.
-    static const std::set<std::string> timedOnly = {"vdbmarch:spp", "vdbmarch:photonPasses"};
-    return always.count(name) || (timed && timedOnly.count(name));
+    // A tile given a time budget renders as many samples as fit; a part by
+    // passes renders the samples of its passes.
+    static const std::set<std::string> samples = {"vdbmarch:spp", "vdbmarch:photonPasses", PassSamplesAttribute};
+    return always.count(name) || ((timed || byPasses) && samples.count(name));
 }
 
-std::string describe(const PixelRect& r) {
-    return str("[", r.x0, ", ", r.x1, ") x [", r.y0, ", ", r.y1, ")");
+// The attributes of the merged frame: the first tile's, without the tile's
+// own, with the total time and `replaced` values.
+StringAttributes mergedAttributes(const Tile& ref, size_t tiles, double seconds,
+                                  const std::map<std::string, std::string>& replaced) {
+    StringAttributes out;
+    for (const auto& [k, v] : ref.contents.attributes) {
+        if (k == TileSplitAttribute || k == TileAttribute || k == PassSamplesAttribute) continue;
+        auto it = replaced.find(k);
+        out.emplace_back(k, k == "vdbmarch:renderSeconds" ? str(seconds) : it != replaced.end() ? it->second : v);
+    }
+    out.emplace_back("vdbmarch:mergedFrom", str(tiles, " tiles (", ref.attribute(TileSplitAttribute), ")"));
+    return out;
+}
+
+// Parts by passes: every pass of the render once, folded in pass order into
+// the totals exactly as one process does (PixelSums), then averaged.
+MergedTiles mergePasses(const std::vector<Tile>& parts) {
+    const Tile& ref = parts.front();
+    const int total = std::atoi(ref.attribute(TileSplitAttribute).c_str());
+    const PixelRect frame = ref.contents.window.display;
+    std::vector<const Tile*> owner(size_t(total), nullptr);
+    for (const Tile& t : parts) {
+        if (t.contents.window.data != frame)
+            throw InputError(str(t.path, ": damaged part: a part by passes covers the whole frame ", describe(frame),
+                                 ", not ", describe(t.contents.window.data)));
+        if (t.endPass > total)
+            throw InputError(str(t.path, ": damaged part: passes ", t.firstPass, "-", t.endPass, " of ", total));
+        for (int p = t.firstPass; p < t.endPass; ++p) {
+            if (owner[size_t(p)])
+                throw InputError(str(owner[size_t(p)]->path, " and ", t.path, " both hold photon pass ", p));
+            owner[size_t(p)] = &t;
+        }
+    }
+    std::string missing;
+    int n = 0;
+    for (int p = 0; p < total; ++p)
+        if (!owner[size_t(p)]) {
+            if (n < 8) missing += str(n ? ", " : "", p);
+            ++n;
+        }
+    if (n) throw InputError(str("merge: ", n, " of ", total, " photon passes missing: ", missing, n > 8 ? ", ..." : "",
+                                "; nothing written"));
+    const size_t pixels = size_t(frame.width()) * size_t(frame.height());
+    PixelSums sums(pixels);
+    double seconds = 0;
+    for (const Tile& t : parts) seconds += std::atof(t.attribute("vdbmarch:renderSeconds").c_str());
+    for (int p = 0; p < total; ++p) {
+        const Tile& t = *owner[size_t(p)];
+        const std::string name = str("pass", p);
+        const ExrLayer* layer = nullptr;
+        for (const ExrLayer& l : t.contents.layers)
+            if (l.name == name) layer = &l;
+        int samples = 0;
+        for (const auto& [q, k] : t.samples)
+            if (q == p) samples = k;
+        if (!layer || layer->channels != std::vector<std::string>{"B", "G", "R", "T"} || samples <= 0)
+            throw InputError(str(t.path, ": damaged part: no layer ", name, " (B, G, R, T) or no sample count for it"));
+        PassSums pass;
+        pass.pass = p;
+        pass.samples = samples;
+        pass.L.resize(pixels);
+        pass.T.resize(pixels);
+        // The file's channels are in name order: B, G, R, T.
+        for (size_t i = 0; i < pixels; ++i) {
+            const float* v = &layer->pixels[4 * i];
+            pass.L[i] = Color(v[2], v[1], v[0]);
+            pass.T[i] = v[3];
+        }
+        sums.fold(pass);
+    }
+    MergedTiles out;
+    out.frame.image = sums.average(frame.width(), frame.height());
+    out.frame.window = {frame, frame};
+    out.frame.attributes = mergedAttributes(ref, parts.size(), seconds,
+                                            {{"vdbmarch:spp", str(sums.samples)}, {"vdbmarch:photonPasses", str(total)}});
+    return out;
 }
 
 // "4-16", or "16" when all agree.
@@ -121,7 +229,22 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
             throw InputError(str(path, ": not a vdbmarch tile (no ", TileSplitAttribute,
                                  " attribute): render tiles with --tile I/N or --crop"));
         const std::string& split = t.attribute(TileSplitAttribute);
-        if (split != "crop") {
+        const size_t space = split.find(' ');
+        if (space != std::string::npos && split.substr(space) == " passes") {
+            char extra = 0;
+            const int total = std::atoi(split.c_str());
+            if (std::sscanf(t.attribute(TileAttribute).c_str(), "%d-%d%c", &t.firstPass, &t.endPass, &extra) != 2 ||
+                split != str(total, " passes") || total < 1 || t.firstPass < 0 || t.endPass <= t.firstPass)
+                throw InputError(str(path, ": damaged part header: ", TileSplitAttribute, " = \"", split, "\", ",
+                                     TileAttribute, " = \"", t.attribute(TileAttribute), "\""));
+            for (const std::string& item : splitList(t.attribute(PassSamplesAttribute))) {
+                int p = 0, k = 0;
+                if (std::sscanf(item.c_str(), "%d:%d%c", &p, &k, &extra) != 2)
+                    throw InputError(str(path, ": damaged part header: ", PassSamplesAttribute, " = \"",
+                                         t.attribute(PassSamplesAttribute), "\""));
+                t.samples.emplace_back(p, k);
+            }
+        } else if (split != "crop") {
             char extra = 0;
             if (std::sscanf(t.attribute(TileAttribute).c_str(), "%d/%d%c", &t.index, &t.count, &extra) != 2 ||
                 split != str(t.count, " bands") || t.index < 0 || t.index >= t.count)
@@ -149,7 +272,7 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
     for (const Tile& t : tiles) {
         if (&t == &ref) continue;
         for (const std::string& k : keys) {
-            if (perTileAttribute(k, timed) || t.attribute(k) == ref.attribute(k)) continue;
+            if (perTileAttribute(k, timed, ref.firstPass >= 0) || t.attribute(k) == ref.attribute(k)) continue;
             throw InputError(str(t.path, ": belongs to another render than ", ref.path, ": ", k, " is \"",
                                  printableExcerpt(t.attribute(k)), "\" there and \"", printableExcerpt(ref.attribute(k)),
                                  "\" in ", ref.path,
@@ -159,6 +282,7 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
             throw InputError(str(t.path, ": belongs to another render than ", ref.path, ": its frame is ",
                                  t.contents.window.display.width(), "x", t.contents.window.display.height(), ", not ",
                                  ref.contents.window.display.width(), "x", ref.contents.window.display.height()));
+        if (ref.firstPass >= 0) continue;  // parts by passes hold one layer per pass
         bool sameLayers = t.contents.layers.size() == ref.contents.layers.size();
         for (size_t i = 0; sameLayers && i < t.contents.layers.size(); ++i)
             sameLayers = t.contents.layers[i].name == ref.contents.layers[i].name &&
@@ -167,6 +291,7 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
             throw InputError(str(t.path, ": belongs to another render than ", ref.path, ": its AOV layers differ"));
     }
 
+    if (ref.firstPass >= 0) return mergePasses(tiles);
     const PixelRect frame = ref.contents.window.display;
     for (const Tile& t : tiles) {
         const PixelRect& d = t.contents.window.data;
@@ -242,14 +367,10 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
             copyRows(t.contents.layers[i].pixels, m.layers[i].pixels, m.layers[i].channels.size());
         seconds += std::atof(t.attribute("vdbmarch:renderSeconds").c_str());
     }
-    for (const auto& [k, v] : ref.contents.attributes) {
-        if (k == TileSplitAttribute || k == TileAttribute) continue;
-        if (k == "vdbmarch:renderSeconds") m.attributes.emplace_back(k, str(seconds));
-        else if (timed && (k == "vdbmarch:spp" || k == "vdbmarch:photonPasses"))
-            m.attributes.emplace_back(k, valueRange(tiles, k));
-        else m.attributes.emplace_back(k, v);
-    }
-    m.attributes.emplace_back("vdbmarch:mergedFrom", str(tiles.size(), " tiles (", ref.attribute(TileSplitAttribute), ")"));
+    std::map<std::string, std::string> replaced;
+    if (timed)
+        for (const char* k : {"vdbmarch:spp", "vdbmarch:photonPasses"}) replaced[k] = valueRange(tiles, k);
+    m.attributes = mergedAttributes(ref, tiles.size(), seconds, replaced);
     if (timed && valueRange(tiles, "vdbmarch:spp").find('-') != std::string::npos)
         out.warnings.push_back(str("the tiles were rendered with a time budget and reached ", valueRange(tiles, "vdbmarch:spp"),
                                    " samples per pixel: noise (and, with photons, bias) may differ between tiles"));

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "cache/cache_build.h"
 #include "core/error.h"
@@ -135,10 +136,22 @@ bool PhotonPasses::needsWork(int pass) const {
 
 bool PhotonPasses::advance(const Scene& scene, int pass, Illumination& il) const {
     if (pass == il.pass) return false;
+    if (pass < il.pass) throw std::logic_error("PhotonPasses::advance: passes only go forward");
+    // A jump over passes (a render of a later range of passes, render
+    // --passes) still makes the cache refinements of the passes it skips,
+    // from their own batches, so the cache of pass j is the same whichever
+    // pass a render started from.
+    bool changed = false;
+    for (int k = il.pass + 1; k < pass; ++k)
+        if (refinesCacheAt(k) && il.cache && !il.cacheLoaded) changed |= tracePass(scene, k, false, il);
     il.pass = pass;
     il.radiusScale = float(progressiveRadiusScale(pass, mRequest.photons.alpha));
+    return tracePass(scene, pass, mRequest.indirect, il) || changed;
+}
+
+bool PhotonPasses::tracePass(const Scene& scene, int pass, bool makeMap, Illumination& il) const {
     const bool refine = refinesCacheAt(pass) && il.cache && !il.cacheLoaded;
-    if (!mRequest.indirect && !refine) return false;
+    if (!makeMap && !refine) return false;
     const auto start = Clock::now();
     PhotonSet set = tracePhotons(scene, size_t(mRequest.photons.count), batchSeed(mRequest, pass));
     IlluminationStats& st = il.stats;
@@ -147,7 +160,7 @@ bool PhotonPasses::advance(const Scene& scene, int pass, Illumination& il) const
     st.photons += set.photons.size();
     st.directPhotons += set.directCount;
     ++st.batches;
-    if (mRequest.indirect) il.indirect = indirectMap(set.photons, mRequest);
+    if (makeMap) il.indirect = indirectMap(set.photons, mRequest);
     if (refine) {
         const auto estimateStart = Clock::now();
         PhotonMap all(std::move(set.photons));

@@ -85,12 +85,16 @@ public:
     // True when moving to `pass` traces photons (a new map or a refinement).
     bool needsWork(int pass) const;
     // Brings `il` (built by buildIllumination from the same request) to
-    // `pass`: its radius, its own batch and map, and the cache refinement.
+    // `pass`: its radius, its own batch and map, and the cache refinements
+    // up to it (those of skipped passes too).
     // Returns true when the cache changed (what a guided marcher measured
     // from it must be measured again); the map and radius are read live.
     bool advance(const Scene& scene, int pass, Illumination& il) const;
 
 private:
+    // Traces pass `pass`'s batch when it makes the map (`makeMap`) or
+    // refines the cache; true when the cache changed.
+    bool tracePass(const Scene& scene, int pass, bool makeMap, Illumination& il) const;
     IlluminationRequest mRequest;
     bool mProgressive = false;
     int mSamplesPerPass = 1;

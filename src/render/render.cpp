@@ -117,6 +117,25 @@ std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const std:
 
 }  // namespace
 
+void PixelSums::fold(const PassSums& pass) {
+    for (size_t i = 0; i < L.size(); ++i) {
+        L[i] += pass.L[i];
+        T[i] += double(pass.T[i]);
+    }
+    samples += pass.samples;
+}
+
+Image PixelSums::average(int width, int height) const {
+    Image img(width, height);
+    const float inv = 1.f / float(samples);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const size_t p = size_t(y) * size_t(width) + size_t(x);
+            img.set(x, y, L[p] * inv, clamp(1.f - float(T[p]) * inv, 0.f, 1.f));
+        }
+    return img;
+}
+
 PixelRect tileOfFrame(int index, int count, int width, int height) {
     if (count < 1 || count > height)
         throw InputError(str("--tile ", index, "/", count, ": the frame is split into horizontal bands of rows, so the "
@@ -128,7 +147,8 @@ PixelRect tileOfFrame(int index, int count, int width, int height) {
 }
 
 void checkImageMemory(int width, int height, const AovSet& aovs) {
-    const uint64_t perPixel = sizeof(Color) + sizeof(double) + 4 * sizeof(float) + AovSums::bytesPerPixel(aovs);
+    // The totals, the open pass's sums, the RGBA result and the AOVs.
+    const uint64_t perPixel = 2 * sizeof(Color) + sizeof(double) + 5 * sizeof(float) + AovSums::bytesPerPixel(aovs);
     checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
@@ -149,10 +169,11 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const int tiles = tilesX * tilesY;
     const bool timed = options.timeBudget > 0;
     RenderResult result;
-    result.image = Image(ww, wh);
     result.window = window;
-    std::vector<Color> sums(size_t(ww) * size_t(wh), Color(0));
-    std::vector<double> transmittances(size_t(ww) * size_t(wh), 0.0);
+    const size_t pixels = size_t(ww) * size_t(wh);
+    PixelSums sums(pixels);
+    PassSums open;  // the sums of the pass being rendered
+    open.pass = -1;
     const AovSet& aovs = rs.aovs;
     AovSums aovSums(aovs, size_t(ww) * size_t(wh));
     std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
@@ -189,8 +210,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                         for (int x = x0; x < std::min(x0 + TileSize, window.x1); ++x) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
-                            Color& sum = sums[local];
-                            double& transmittance = transmittances[local];
+                            Color& sum = open.L[local];
+                            float& transmittance = open.T[local];
                             for (int s = s0; s < s1; ++s) {
                                 Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
                                 float jx = 0.5f, jy = 0.5f;
@@ -228,6 +249,25 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         });
     };
 
+    // A pass's sums are folded into the totals when the next pass starts and
+    // at the end (and kept apart with options.passes).
+    auto closePass = [&] {
+        if (open.pass < 0) return;
+        sums.fold(open);
+        if (options.passes) result.passSums.push_back(std::move(open));
+        open = PassSums();
+        open.pass = -1;
+    };
+    auto openPass = [&](int pass, int samples) {
+        if (open.pass != pass) {
+            closePass();
+            open.pass = pass;
+            open.L.assign(pixels, Color(0));
+            open.T.assign(pixels, 0.f);
+        }
+        open.samples += samples;
+    };
+
     // Samples [s0, s1), pass by pass of photons: the marcher reads the pass's
     // map and radius through `illumination`, and is made again only when the
     // cache was refined (eq. 17's scale is measured from the cache).
@@ -241,15 +281,38 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                 });
             }
             const int end = std::min(s1, photonPasses.progressive() ? photonPasses.firstSampleOf(pass + 1) : s1);
+            openPass(pass, end - s);
             renderPass(s, end);
             s = end;
         }
     };
 
+    // The passes of the whole render, and the samples of the passes asked for.
+    const int totalPasses = photonPasses.passOf(std::max(0, rs.spp - 1)) + 1;
+    result.totalPhotonPasses = timed ? 0 : totalPasses;
+    int first = 0, last = rs.spp;
+    if (options.passes) {
+        const auto [a, b] = *options.passes;
+        if (timed) throw InputError("--passes and --time: a part of a render by passes renders fixed samples");
+        if (aovs.any())
+            throw InputError(str("--passes ", a, "-", b, " and render.aovs: AOVs are not split by passes; split the "
+                                 "render by tiles instead"));
+        if (!photonPasses.progressive())
+            throw InputError(str("--passes ", a, "-", b, ": this render has no progressive photon passes (method ",
+                                 methodName(rs.method), "): split it by tiles instead"));
+        if (a < 0 || b <= a || b > totalPasses)
+            throw InputError(str("--passes ", a, "-", b, ": this render has passes 0 to ", totalPasses - 1, " (",
+                                 rs.spp, " spp, ", photonPasses.samplesPerPass(), " per pass); the range is FIRST-END "
+                                 "with END excluded, at most ", totalPasses));
+        first = photonPasses.firstSampleOf(a);
+        last = std::min(rs.spp, photonPasses.firstSampleOf(b));
+    }
+    result.firstSample = first;
+
     int spp = 0;
     if (!timed) {
-        renderSamples(0, rs.spp);
-        spp = rs.spp;
+        renderSamples(first, last);
+        spp = last - first;
     } else {
         // Whole passes of one sample per pixel while the next one is expected
         // to finish within the budget (which also covers loading, measured
@@ -277,13 +340,9 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     result.illuminationSeconds = illumination->stats.seconds;
     result.photons = illumination->stats.photons;
     result.photonPasses = illumination->pass + 1;
-    const float inv = 1.f / float(spp);
-    for (int y = 0; y < wh; ++y)
-        for (int x = 0; x < ww; ++x) {
-            size_t pixel = size_t(y) * size_t(ww) + size_t(x);
-            result.image.set(x, y, sums[pixel] * inv, clamp(1.f - float(transmittances[pixel]) * inv, 0.f, 1.f));
-        }
-    result.layers = aovLayers(aovs, aovSums, sums, spp);
+    closePass();
+    result.image = sums.average(ww, wh);
+    result.layers = aovLayers(aovs, aovSums, sums.L, spp);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (const auto& c : tileCounters) result.counters += c;
     return result;

@@ -5,6 +5,8 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/stats.h"
 #include "image/exr_io.h"
@@ -27,6 +29,33 @@ struct RenderOptions {
     // the photons and cache are those of the whole frame, so a tile is
     // bit-identical to its part of the whole render.
     std::optional<PixelRect> crop;
+    // Render only the camera samples of photon passes [first, second)
+    // (render --passes): the part of a progressive render one machine takes.
+    // The result keeps each pass's sums (RenderResult::passSums) for merge.
+    std::optional<std::pair<int, int>> passes;
+};
+
+// The sums of one photon pass's samples per pixel: radiance and
+// transmittance, each summed in sample order from zero.
+struct PassSums {
+    int pass = 0;
+    int samples = 0;
+    std::vector<Color> L;
+    std::vector<float> T;
+};
+
+// A render's per-pixel totals. Samples are summed per photon pass and the
+// passes folded in pass order, so a render split by passes across machines
+// (render --passes, merge) adds the same numbers in the same order as one
+// process, and the image is bit-identical.
+struct PixelSums {
+    std::vector<Color> L;
+    std::vector<double> T;
+    int samples = 0;
+    explicit PixelSums(size_t pixels) : L(pixels, Color(0)), T(pixels, 0.0) {}
+    void fold(const PassSums& pass);
+    // RGB = L / samples, alpha = 1 - T / samples.
+    Image average(int width, int height) const;
 };
 
 struct RenderResult {
@@ -42,6 +71,9 @@ struct RenderResult {
     // The AOVs render.aovs asks for, as EXR layers (docs/aovs.md), in the
     // order depth, albedo, normal, direct, indirect.
     std::vector<ExrLayer> layers;
+    std::vector<PassSums> passSums;  // with RenderOptions::passes: each pass rendered, in order
+    int firstSample = 0;             // of the samples rendered (0 unless RenderOptions::passes)
+    int totalPhotonPasses = 1;       // the passes of the whole render.spp
 };
 
 // Depth AOV of a pixel whose samples met nothing: far, but finite so that
@@ -49,8 +81,8 @@ struct RenderResult {
 constexpr float NoDepth = 1e10f;
 
 // Refuses (InputError naming camera.resolution) an image whose buffers do
-// not fit in this machine's memory: per pixel the RGB sum, the transmittance
-// sum and the RGBA result, and the sums and layers of the AOVs.
+// not fit in this machine's memory: per pixel the sums (PixelSums and the
+// open pass's), the RGBA result, and the sums and layers of the AOVs.
 void checkImageMemory(int width, int height, const AovSet& aovs = {});
 
 // Tile `index` of `count` of a width x height frame: horizontal bands of

@@ -1,6 +1,7 @@
-// `render --tile / --crop` and `merge` through the command (docs/farm.md):
-// tiles merged in any order are bit-identical to a one-process render
-// (`compare --identical`), and merge refuses, naming the file, a missing,
+// `render --tile / --crop / --passes` and `merge` through the command
+// (docs/farm.md): tiles (or parts by photon passes) merged in any order are
+// bit-identical to a one-process render (`compare --identical`), and merge
+// refuses, naming the file, a missing,
 // duplicate, overlapping, foreign or non-tile input, writing nothing and
 // leaving an existing output as it was.
 #include <gtest/gtest.h>
@@ -148,6 +149,47 @@ TEST_F(TilesCli, TimedTilesMergeWithTheirSampleRange) {
                                  "-q", "-o", "t1b.exr"});
     ASSERT_EQ(other.exitCode, 0) << other.err;
     expectCliError(merge({"t0.exr", "t1b.exr"}), {"t1b.exr", "vdbmarch:timeBudget"});
+}
+
+// A progressive render split by photon passes (render --passes): parts
+// rendered apart, each tracing its passes' own photon batches and the cache
+// refinements of the passes before them, merge bit-identically; a missing
+// or doubled pass is named.
+TEST_F(TilesCli, PartsByPhotonPassesMergeBitIdentically) {
+    auto renderGlass = [&](const std::string& out, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"render", samplePath("glass.json"), "--res", "32x24", "--spp", "9", "--method",
+                                         "guided", "--set", "photons.spp_per_pass=2", "--set", "photons.count=20000",
+                                         "--step", "0.06", "-q", "-o", out};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const CliResult r = cli(args);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+    };
+    renderGlass("single.exr", {"--threads", "2"});
+    renderGlass("a.exr", {"--passes", "0-1", "--threads", "1"});
+    renderGlass("b.exr", {"--passes", "1-4", "--threads", "2"});  // crosses the refinements at passes 1 and 3
+    renderGlass("c.exr", {"--passes", "4-5", "--threads", "1"});  // starts after both: makes them itself
+    const ExrContents c = readExrContents(work("c.exr"));
+    ASSERT_EQ(c.layers.size(), 1u);
+    EXPECT_EQ(c.layers[0].name, "pass4");
+    ASSERT_EQ(merge({"c.exr", "a.exr", "b.exr"}).exitCode, 0);
+    const CliResult same = identical("merged.exr", "single.exr");
+    EXPECT_EQ(same.exitCode, 0) << same.out;
+    std::string spp;
+    for (const auto& [k, v] : readExrStringAttributes(work("merged.exr")))
+        if (k == "vdbmarch:spp") spp = v;
+    EXPECT_EQ(spp, "9");
+    expectCliError(merge({"a.exr", "c.exr"}), {"3 of 5 photon passes missing: 1, 2, 3", "nothing written"});
+    renderGlass("b2.exr", {"--passes", "0-2"});
+    expectCliError(merge({"a.exr", "b2.exr", "c.exr"}), {"a.exr and b2.exr both hold photon pass 0"});
+    // Beyond the render's passes, or a render without progressive passes.
+    expectCliError(cli({"render", samplePath("glass.json"), "--res", "32x24", "--spp", "9", "--method", "guided", "--set",
+                        "photons.spp_per_pass=2", "--passes", "3-6", "-o", "x.exr"}),
+                   {"--passes 3-6", "passes 0 to 4"});
+    expectCliError(cli({"render", samplePath("cloud.json"), "--method", "reference", "--passes", "0-1", "-o", "x.exr"}),
+                   {"--passes 0-1", "no progressive photon passes", "tiles"});
+    expectCliError(cli({"render", samplePath("cloud.json"), "--passes", "0-1", "--tile", "0/2", "-o", "x.exr"}),
+                   {"--passes 0-1", "--tile 0/2"});
+    EXPECT_FALSE(fs::exists(work("x.exr")));
 }
 
 }  // namespace
