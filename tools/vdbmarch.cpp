@@ -63,6 +63,9 @@ int main(int argc, char** argv) {
     render->add_option("--save-scene", ra.saveScene,
                        "Write the effective scene (after --set and options; the generated one for a .vdb) as JSON");
     render->add_option("--cache", ra.cache, "Use this baked cache (vdbmarch bake) instead of building one");
+    render->add_option("--frames", ra.frames,
+                       "Render frames A-B[:STEP] (or one frame N) in turn: '####' in the input, the scene's file "
+                       "paths, -o, --png, --stats, --save-scene and --cache is the frame number, zero-padded");
     render->add_flag("--force", ra.force, "Use a --cache baked for another scene (warns)");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or summary line");
     render->add_flag("--no-progress", ra.noProgress, "No progress bar");
@@ -129,6 +132,9 @@ int main(int argc, char** argv) {
     bake->add_flag("--uniform", ka.uniform, "Uniform cache even if the scene asks for an adaptive one");
     bake->add_option("--set", ka.sets, "Override a scene key: key.path=value, repeatable");
     bake->add_option("--stats", ka.stats, "Write timings, counts and memory as JSON");
+    bake->add_option("--frames", ka.frames,
+                     "Bake frames A-B[:STEP] (or one frame N) in turn: '####' in the input, the scene's file paths, "
+                     "-o and --stats is the frame number, zero-padded");
     bake->add_flag("-q,--quiet", ka.quiet, "No summary line");
 
     InspectArgs ia;

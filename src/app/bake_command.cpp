@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/threads.h"
 #include "illumination/bake.h"
+#include "parse/frames.h"
 #include "scene/scene.h"
 
 namespace vdbmarch {
@@ -45,9 +46,9 @@ std::string statsJson(const BakeResult& r, int threads) {
     return s.dump(2) + "\n";
 }
 
-}  // namespace
-
-int runBake(const BakeArgs& a) {
+// One bake: the whole command for one frame (`frame` set by --frames, its
+// paths already substituted in `a`) or without frames.
+int bakeFrame(const BakeArgs& a, std::optional<int> frame) {
     if (!endsWith(a.output, ".vdb")) throw InputError(str("-o ", a.output, ": the cache must be a .vdb file"));
     if (!a.stats.empty() && !endsWith(a.stats, ".json"))
         throw InputError(str("--stats ", a.stats, ": the statistics file must be a .json file"));
@@ -60,7 +61,7 @@ int runBake(const BakeArgs& a) {
     appendSceneOverrides(a, bakeSceneOptions(), overrides);
     if (a.adaptive) overrides.push_back("cache.adaptive=true");
     if (a.uniform) overrides.push_back("cache.adaptive=false");
-    SceneDesc desc = loadSceneInput(a.input, overrides);
+    SceneDesc desc = loadSceneInput(a.input, overrides, frame);
     std::unique_ptr<Scene> scene = buildScene(desc);
     const int threads = resolveThreadCount(desc.render.threads);
     tbb::task_arena arena(threads);
@@ -76,6 +77,28 @@ int runBake(const BakeArgs& a) {
                      r.paths, static_cast<unsigned long long>(c.info.photons), r.directPhotons, r.traceSeconds,
                      r.treeSeconds, c.cells.size(), c.levels, c.info.shOrder, r.topologySeconds + r.estimateSeconds,
                      r.totalSeconds, a.output.c_str());
+    return 0;
+}
+
+}  // namespace
+
+// --frames: a cache per frame, each baked as if alone (docs/farm-frames.md).
+int runBake(const BakeArgs& a) {
+    const std::vector<std::pair<std::string, std::string>> outputs = {{"-o", a.output}, {"--stats", a.stats}};
+    if (a.frames.empty()) {
+        checkFrameOutputs(outputs, 0, "");
+        return bakeFrame(a, std::nullopt);
+    }
+    const std::vector<int> frames = parseFrameRange(a.frames);
+    checkFrameOutputs(outputs, frames.size(), a.frames);
+    checkFrameInputs(a.input, a.sets, frames);
+    for (int frame : frames)
+        runFrame(frame, [&] {
+            BakeArgs f = a;
+            f.output = substituteFrame(a.output, frame);
+            f.stats = substituteFrame(a.stats, frame);
+            bakeFrame(f, frame);
+        });
     return 0;
 }
 

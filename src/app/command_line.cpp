@@ -2,11 +2,16 @@
 
 #include "app/vdb_check.h"
 
+#include <sys/stat.h>
+
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
+#include "parse/frames.h"
 #include "scene/auto_scene.h"
 
 namespace vdbmarch {
@@ -45,16 +50,57 @@ std::vector<double> parseNumberList(const std::string& s, const std::string& opt
     return out;
 }
 
-SceneDesc loadSceneInput(const std::string& input, const std::vector<std::string>& overrides) {
+SceneDesc loadSceneInput(const std::string& input, const std::vector<std::string>& overrides,
+                         std::optional<int> frame) {
     // Every VDB file is read once in a child process before this one opens
     // it (app/vdb_check.h): a damaged file is an error, never a crash.
     if (endsWith(input, ".vdb")) {
-        checkVdbFilesIsolated({input});
-        return loadAutoScene(input, overrides);
+        if (!frame && hasFrameToken(input))
+            throw InputError(str(input, ": the input holds the frame token (a run of '#'): render it with --frames "
+                                        "(e.g. --frames 1-100) to replace the token by each frame's number"));
+        const std::string path = frame ? substituteFrame(input, *frame) : input;
+        checkVdbFilesIsolated({path});
+        return loadAutoScene(path, overrides, frame);
     }
-    SceneDesc desc = loadSceneFile(input, overrides);
+    SceneDesc desc = loadSceneFile(input, overrides, frame);
     checkVdbFilesIsolated(vdbFilesOf(desc));
     return desc;
+}
+
+void checkFrameOutputs(const std::vector<std::pair<std::string, std::string>>& outputs, size_t frameCount,
+                       const std::string& framesText) {
+    for (const auto& [option, path] : outputs) {
+        if (path.empty()) continue;
+        if (frameCount == 0 && hasFrameToken(path))
+            throw InputError(str(option, " ", path, ": the name holds the frame token (a run of '#'), which only "
+                                 "--frames replaces: pass --frames (e.g. --frames 1-100), or leave '#' out of the name"));
+        if (frameCount > 1 && !hasFrameToken(path))
+            throw InputError(str(option, " ", path, ": --frames ", framesText, " runs ", frameCount,
+                                 " frames, and every frame would overwrite this one file: put the frame token in "
+                                 "the name (e.g. name.####.ext, #### = the frame number padded to 4 digits)"));
+    }
+}
+
+void checkFrameInputs(const std::string& input, const std::vector<std::string>& overrides,
+                      const std::vector<int>& frames,
+                      const std::vector<std::pair<std::string, std::string>>& inputOptions) {
+    for (int frame : frames) {
+        std::vector<std::pair<std::string, std::string>> files;  // what names it, the path
+        for (const auto& [option, pattern] : inputOptions)
+            if (!pattern.empty()) files.emplace_back(option, substituteFrame(pattern, frame));
+        if (endsWith(input, ".vdb")) {
+            files.emplace_back("the input " + input, substituteFrame(input, frame));
+        } else {
+            // Parsing only (cheap): the files are opened when the frame runs.
+            const SceneDesc desc = loadSceneFile(input, overrides, frame);
+            for (const auto& [key, path] : sceneFilePaths(desc)) files.emplace_back(str(key, " of ", input), path);
+        }
+        for (const auto& [what, path] : files) {
+            struct stat st;
+            if (::stat(path.c_str(), &st) != 0)
+                throw InputError(str(path, ": frame ", frame, " (", what, "): ", std::strerror(errno)));
+        }
+    }
 }
 
 }  // namespace vdbmarch

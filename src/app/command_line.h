@@ -7,6 +7,7 @@
 #include <optional>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -27,8 +28,39 @@ std::vector<std::string> splitList(const std::string& s);
 // A comma-separated list of numbers; `option` names it in the error.
 std::vector<double> parseNumberList(const std::string& s, const std::string& option);
 
-// A scene file, or the automatic scene of a bare .vdb, with the overrides applied.
-SceneDesc loadSceneInput(const std::string& input, const std::vector<std::string>& overrides);
+// A scene file, or the automatic scene of a bare .vdb, with the overrides
+// applied. With a `frame` (--frames), the frame token of a bare .vdb input
+// and of the scene's file paths becomes the frame number (parse/frames.h);
+// without one, a token in them is an error that asks for --frames.
+SceneDesc loadSceneInput(const std::string& input, const std::vector<std::string>& overrides,
+                         std::optional<int> frame = std::nullopt);
+
+// --frames, shared by render and bake (docs/farm-frames.md).
+//
+// The path options of a run (option name and path; an empty path is an
+// option not given): with `frameCount` 0 (no --frames), a path holding the
+// frame token is an error that asks for --frames; with several frames, every
+// one must hold the token (pass outputs only: each frame would overwrite the
+// one file).
+void checkFrameOutputs(const std::vector<std::pair<std::string, std::string>>& outputs, size_t frameCount,
+                       const std::string& framesText);
+// Before the first frame runs: every frame's scene parses and every file it
+// names (and each per-frame input option, such as render --cache) exists; a
+// missing one is an InputError naming the file, the frame and the key.
+void checkFrameInputs(const std::string& input, const std::vector<std::string>& overrides,
+                      const std::vector<int>& frames,
+                      const std::vector<std::pair<std::string, std::string>>& inputOptions = {});
+// Runs one frame's job; its error is rethrown with "frame N: " in front.
+template <class Job>
+void runFrame(int frame, Job&& job) {
+    try {
+        job();
+    } catch (const InputError& e) {
+        throw InputError(str("frame ", frame, ": ", e.what()));
+    } catch (const IoError& e) {
+        throw IoError(str("frame ", frame, ": ", e.what()));
+    }
+}
 
 // A command-line option that overrides one scene key: `--spp 4` is the
 // override render.spp=4, validated by the scene parser like any other key.

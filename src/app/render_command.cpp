@@ -15,6 +15,7 @@
 #include "core/atomic_file.h"
 #include "image/exr_io.h"
 #include "image/png_io.h"
+#include "parse/frames.h"
 #include "parse/method.h"
 #include "parse/scene_json.h"
 #include "render/render.h"
@@ -113,9 +114,9 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     return s.dump(2) + "\n";
 }
 
-}  // namespace
-
-int runRender(const RenderArgs& a) {
+// One render: the whole command for one frame (`frame` set by --frames, its
+// paths already substituted in `a`) or without frames.
+int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     auto t0 = std::chrono::steady_clock::now();
     validate(a);
     // Command-line options are overrides of the scene document, so they are
@@ -128,13 +129,13 @@ int runRender(const RenderArgs& a) {
     if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
 
     if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
-    SceneDesc desc = loadSceneInput(a.input, overrides);
+    SceneDesc desc = loadSceneInput(a.input, overrides, frame);
     if (a.preview) {
         // A quick look: the same scene with a quarter of the pixels, an
         // eighth of the samples (or of the time) and a quarter of the photons.
         const std::vector<std::string> p = previewOverrides(desc);
         overrides.insert(overrides.end(), p.begin(), p.end());
-        desc = loadSceneInput(a.input, overrides);
+        desc = loadSceneInput(a.input, overrides, frame);
     }
     const TileRequest tile = parseTileRequest(a.tile, a.crop, a.passes);
     const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
@@ -170,6 +171,7 @@ int runRender(const RenderArgs& a) {
         {"vdbmarch:scene", desc.jsonText},
         {RenderHashAttribute, renderHash(desc, a.cache)},
     };
+    if (desc.frame) attrs.emplace_back("vdbmarch:frame", std::to_string(*desc.frame));
     if (!a.cache.empty()) attrs.emplace_back("vdbmarch:cache", a.cache);
     for (auto& kv : tileAttributes(tile, r)) attrs.push_back(std::move(kv));
     if (tile.byPasses()) r.layers = passLayers(r);
@@ -191,6 +193,33 @@ int runRender(const RenderArgs& a) {
                                r.photonPasses, r.photonPasses == 1 ? " pass, " : " passes, ").c_str()
                          : "",
                      loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
+    return 0;
+}
+
+// The arguments of one frame: the frame token of every path option replaced.
+RenderArgs atFrame(RenderArgs a, int frame) {
+    for (std::string* path : {&a.output, &a.png, &a.stats, &a.saveScene, &a.cache}) *path = substituteFrame(*path, frame);
+    return a;
+}
+
+}  // namespace
+
+// --frames: each frame rendered as if alone, one after the other, with the
+// same seed (docs/farm-frames.md); without it, one render.
+int runRender(const RenderArgs& a) {
+    const std::vector<std::pair<std::string, std::string>> outputs = {
+        {"-o", a.output}, {"--png", a.png}, {"--stats", a.stats}, {"--save-scene", a.saveScene}};
+    if (a.frames.empty()) {
+        std::vector<std::pair<std::string, std::string>> paths = outputs;
+        paths.emplace_back("--cache", a.cache);
+        checkFrameOutputs(paths, 0, "");
+        return renderFrame(a, std::nullopt);
+    }
+    const std::vector<int> frames = parseFrameRange(a.frames);
+    checkFrameOutputs(outputs, frames.size(), a.frames);
+    validate(atFrame(a, frames.front()));
+    checkFrameInputs(a.input, a.sets, frames, {{"--cache", a.cache}});
+    for (int frame : frames) runFrame(frame, [&] { renderFrame(atFrame(a, frame), frame); });
     return 0;
 }
 

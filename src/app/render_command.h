@@ -17,6 +17,7 @@ struct RenderArgs {
     bool preview = false;  // --preview: a quick look (previewOverrides in render_command.cpp)
     std::optional<double> timeBudget;  // --time
     std::vector<std::string> sets;     // --set key.path=value
+    std::string frames;                // --frames A-B[:STEP] or N (parse/frames.h); empty: no frames
     // Scene overrides (renderSceneOptions); unset ones keep the scene's values.
     std::string method, li, aovs;
     std::optional<int> spp, threads, raySamples, shOrder;
@@ -27,6 +28,7 @@ struct RenderArgs {
 // The options of `render` that override scene keys (--spp -> render.spp, ...).
 const SceneOptionTable<RenderArgs>& renderSceneOptions();
 
+// Renders once, or each frame of --frames in turn.
 int runRender(const RenderArgs& args);
 
 }  // namespace vdbmarch

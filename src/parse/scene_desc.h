@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/math.h"
@@ -151,15 +153,27 @@ struct SceneDesc {
     PhotonSettings photons;
     CacheSettings cache;
     std::string jsonText;  // the effective document (compact JSON), recorded in outputs
+    // The frame the scene was loaded for (--frames): its file paths have the
+    // frame token replaced (parse/frames.h); none for a single render.
+    std::optional<int> frame;
 };
 
 // Parses scene JSON text; `file` is used in messages and to resolve paths.
 // Throws InputError with file, line and column for malformed JSON, and with
-// the key path and bad value for semantic errors.
+// the key path and bad value for semantic errors. With a `frame`, the frame
+// token (a run of '#') in every file path of the scene becomes that frame
+// number (parse/frames.h), in the description and in its jsonText; without
+// one, a path holding the token is an error that asks for --frames.
 SceneDesc parseSceneText(const std::string& text, const std::string& file,
-                         const std::vector<std::string>& overrides = {});
+                         const std::vector<std::string>& overrides = {}, std::optional<int> frame = std::nullopt);
 // Reads and parses a scene file.
-SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides = {});
+SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides = {},
+                        std::optional<int> frame = std::nullopt);
+
+// The key paths and values of the scene's file paths, resolved against its
+// folder: media[i].file (vdb), surfaces[i].file (mesh, vdb_isosurface) and
+// environment.file.
+std::vector<std::pair<std::string, std::string>> sceneFilePaths(const SceneDesc& desc);
 
 // Hash of everything in the scene that changes the light field (media,
 // lights, surfaces, background, max_depth) but not the camera or render

@@ -3,6 +3,7 @@
 // plain SceneDesc of scene_desc.h, without nlohmann/json.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -13,8 +14,10 @@ namespace vdbmarch {
 
 // Applies one "key.path=value" override (value parsed as JSON, else string).
 void applyOverride(nlohmann::json& doc, const std::string& assignment);
-// Parses an already-built document (used for bare .vdb scenes).
-SceneDesc parseSceneJson(const nlohmann::json& doc, const std::string& file);
+// Parses an already-built document (used for bare .vdb scenes); `frame` as
+// for parseSceneText (scene_desc.h).
+SceneDesc parseSceneJson(const nlohmann::json& doc, const std::string& file,
+                         std::optional<int> frame = std::nullopt);
 // The effective document, pretty-printed.
 std::string prettySceneJson(const SceneDesc& desc, int indent = 2);
 

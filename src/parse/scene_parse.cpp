@@ -12,6 +12,7 @@
 #include "core/hash.h"
 #include "parse/scene_json.h"
 #include "parse/auto_method.h"
+#include "parse/frames.h"
 #include "parse/json_locate.h"
 #include "parse/json_reader.h"
 #include "parse/scene_desc.h"
@@ -373,6 +374,33 @@ PhotonSettings parsePhotons(const JsonReader& r) {
     return s;
 }
 
+// The document with the frame token of its file paths (media[i].file,
+// surfaces[i].file, environment.file) replaced by `frame`; without a frame, a
+// path holding the token is an error naming the key and the value. Values of
+// the wrong type are left for the parser to report.
+Json withFramePaths(const Json& doc, const std::string& file, std::optional<int> frame) {
+    Json out = doc;
+    auto visit = [&](Json& node, const std::string& keyPath) {
+        if (!node.is_object() || !node.contains("file") || !node["file"].is_string()) return;
+        Json& value = node["file"];
+        const std::string path = value.get<std::string>();
+        if (!hasFrameToken(path)) return;
+        if (!frame)
+            throw SceneKeyError(file, keyPath,
+                                str(keyPath, ": \"", path, "\" holds the frame token (a run of '#'): render it with "
+                                             "--frames (e.g. --frames 1-100) to replace the token by each frame's number"));
+        value = substituteFrame(path, *frame);
+    };
+    if (!out.is_object()) return out;
+    for (const char* list : {"media", "surfaces"}) {
+        if (!out.contains(list) || !out[list].is_array()) continue;
+        Json& items = out[list];
+        for (size_t i = 0; i < items.size(); ++i) visit(items[i], str(list, "[", i, "].file"));
+    }
+    if (out.contains("environment")) visit(out["environment"], "environment.file");
+    return out;
+}
+
 CacheSettings parseCache(const JsonReader& r) {
     r.allowOnly({"sh_order", "quality", "adaptive", "min_cell"});
     CacheSettings s;
@@ -409,9 +437,23 @@ std::string resolvePath(const std::string& baseDir, const std::string& path) {
     return baseDir + "/" + path;
 }
 
-SceneDesc parseSceneJson(const Json& doc, const std::string& file) {
+std::vector<std::pair<std::string, std::string>> sceneFilePaths(const SceneDesc& desc) {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (size_t i = 0; i < desc.media.size(); ++i)
+        if (desc.media[i].type == MediumDesc::Type::Vdb) out.emplace_back(str("media[", i, "].file"), desc.media[i].file);
+    for (size_t i = 0; i < desc.surfaces.size(); ++i)
+        if (!desc.surfaces[i].file.empty()) out.emplace_back(str("surfaces[", i, "].file"), desc.surfaces[i].file);
+    if (!desc.environment.file.empty()) out.emplace_back("environment.file", desc.environment.file);
+    return out;
+}
+
+SceneDesc parseSceneJson(const Json& input, const std::string& file, std::optional<int> frame) {
+    // The frame's own paths everywhere, the recorded document included: a
+    // frame's scene is the scene that names its files directly.
+    const Json doc = withFramePaths(input, file, frame);
     SceneDesc scene;
     scene.file = file;
+    scene.frame = frame;
     size_t slash = file.find_last_of('/');
     scene.baseDir = slash == std::string::npos ? "." : file.substr(0, slash == 0 ? 1 : slash);
     scene.jsonText = doc.dump();
@@ -517,7 +559,8 @@ void applyOverride(Json& doc, const std::string& assignment) {
     }
 }
 
-SceneDesc parseSceneText(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
+SceneDesc parseSceneText(const std::string& text, const std::string& file, const std::vector<std::string>& overrides,
+                         std::optional<int> frame) {
     Json doc;
     try {
         doc = Json::parse(text);
@@ -541,7 +584,7 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
     }
     for (const auto& o : overrides) applyOverride(doc, o);
     try {
-        return parseSceneJson(doc, file);
+        return parseSceneJson(doc, file, frame);
     } catch (const SceneKeyError& e) {
         // Point at the key in the file, unless an override replaced it (then
         // the bad value is not in the text).
@@ -563,7 +606,8 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
     }
 }
 
-SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides) {
+SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>& overrides,
+                        std::optional<int> frame) {
     struct stat st;
     if (::stat(path.c_str(), &st) != 0) throw IoError(str(path, ": cannot open scene file: ", std::strerror(errno)));
     if (S_ISDIR(st.st_mode)) throw IoError(str(path, ": is a directory, not a scene file"));
@@ -572,7 +616,7 @@ SceneDesc loadSceneFile(const std::string& path, const std::vector<std::string>&
     std::stringstream ss;
     ss << in.rdbuf();
     if (in.bad()) throw IoError(str(path, ": cannot read scene file: ", std::strerror(errno)));
-    return parseSceneText(ss.str(), path, overrides);
+    return parseSceneText(ss.str(), path, overrides, frame);
 }
 
 }  // namespace vdbmarch

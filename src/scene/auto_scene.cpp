@@ -66,10 +66,11 @@ nlohmann::json autoSceneJson(const std::string& vdbPath) {
     return doc;
 }
 
-SceneDesc loadAutoScene(const std::string& vdbPath, const std::vector<std::string>& overrides) {
+SceneDesc loadAutoScene(const std::string& vdbPath, const std::vector<std::string>& overrides,
+                        std::optional<int> frame) {
     nlohmann::json doc = autoSceneJson(vdbPath);
     for (const auto& o : overrides) applyOverride(doc, o);
-    return parseSceneJson(doc, vdbPath);
+    return parseSceneJson(doc, vdbPath, frame);
 }
 
 }  // namespace vdbmarch

@@ -4,6 +4,7 @@
 // asset reads as a cloud (optical depth ~6 across its typical chord).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,9 @@ namespace vdbmarch {
 // The generated scene as JSON (what --set overrides apply to).
 nlohmann::json autoSceneJson(const std::string& vdbPath);
 
-SceneDesc loadAutoScene(const std::string& vdbPath, const std::vector<std::string>& overrides = {});
+// `vdbPath` is a real file (its frame token already replaced); `frame` is
+// recorded, and replaces the token in paths that overrides set.
+SceneDesc loadAutoScene(const std::string& vdbPath, const std::vector<std::string>& overrides = {},
+                        std::optional<int> frame = std::nullopt);
 
 }  // namespace vdbmarch
