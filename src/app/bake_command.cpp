@@ -82,7 +82,7 @@ int bakeFrame(const BakeArgs& a, std::optional<int> frame) {
 
 }  // namespace
 
-// --frames: a cache per frame, each baked as if alone (docs/farm-frames.md).
+// --frames: a cache per frame, each baked as if alone (docs/farm.md, "Frames").
 int runBake(const BakeArgs& a) {
     const std::vector<std::pair<std::string, std::string>> outputs = {{"-o", a.output}, {"--stats", a.stats}};
     if (a.frames.empty()) {

@@ -35,7 +35,7 @@ std::vector<double> parseNumberList(const std::string& s, const std::string& opt
 SceneDesc loadSceneInput(const std::string& input, const std::vector<std::string>& overrides,
                          std::optional<int> frame = std::nullopt);
 
-// --frames, shared by render and bake (docs/farm-frames.md).
+// --frames, shared by render and bake (docs/farm.md, "Frames").
 //
 // The path options of a run (option name and path; an empty path is an
 // option not given): with `frameCount` 0 (no --frames), a path holding the

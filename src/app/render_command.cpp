@@ -205,7 +205,7 @@ RenderArgs atFrame(RenderArgs a, int frame) {
 }  // namespace
 
 // --frames: each frame rendered as if alone, one after the other, with the
-// same seed (docs/farm-frames.md); without it, one render.
+// same seed (docs/farm.md, "Frames"); without it, one render.
 int runRender(const RenderArgs& a) {
     const std::vector<std::pair<std::string, std::string>> outputs = {
         {"-o", a.output}, {"--png", a.png}, {"--stats", a.stats}, {"--save-scene", a.saveScene}};

@@ -1,4 +1,4 @@
-// Animation frames through the command (docs/farm-frames.md): `--frames
+// Animation frames through the command (docs/farm.md, "Frames"): `--frames
 // A-B[:STEP]` renders (or bakes) each frame in turn, the frame token '####'
 // replaced in the input, the scene's file paths and the output names; each
 // frame's pixels equal, bit for bit, a render of a scene that names that
