@@ -49,10 +49,10 @@ live_pid() {
 
 # Stops the daemon of pid file FILE (program NAME): TERM, then KILL after 10 s.
 stop_pid() {
-  local file=$1 name=$2 pid i
+  local file=$1 name=$2 pid
   if pid=$(live_pid "$file" "$name"); then
     kill -TERM "$pid" 2>/dev/null || true
-    for i in $(seq 1 100); do
+    for _ in $(seq 1 100); do
       [ -d "/proc/$pid" ] || break
       # a zombie child of this shell counts as gone
       grep -q '^State:.*Z' "/proc/$pid/status" 2>/dev/null && break
@@ -69,13 +69,17 @@ stop_pid() {
 # slurmstepd processes of this cluster (they log into our slurmd.log) outlive a
 # killed slurmd; they and their jobs are ours, so end them.
 stop_stepds() {
-  local p
+  local p fd
   for p in /proc/[0-9]*; do
     [ "$(cat "$p/comm" 2>/dev/null)" = slurmstepd ] || continue
-    if ls -l "$p/fd" 2>/dev/null | grep -qF -- "$LOG/"; then
-      say "ending leftover slurmstepd ${p#/proc/}"
-      kill -KILL "${p#/proc/}" 2>/dev/null || true
-    fi
+    for fd in "$p"/fd/*; do
+      case "$(readlink "$fd" 2>/dev/null)" in
+        "$LOG"/*)
+          say "ending leftover slurmstepd ${p#/proc/}"
+          kill -KILL "${p#/proc/}" 2>/dev/null || true
+          break ;;
+      esac
+    done
   done
 }
 
@@ -92,8 +96,7 @@ do_down() {
   if [ -f "$CONF" ] && live_pid "$RUN/slurmctld.pid" slurmctld >/dev/null; then
     # cancel what is queued or running so no job process outlives the cluster
     SLURM_CONF="$CONF" timeout 10 scancel --partition="$PART" >/dev/null 2>&1 || true
-    local i
-    for i in $(seq 1 50); do
+    for _ in $(seq 1 50); do
       [ -z "$(SLURM_CONF="$CONF" timeout 5 squeue -h -t running,completing -o %i 2>/dev/null)" ] && break
       sleep 0.2
     done
@@ -138,10 +141,11 @@ do_up() {
   mkdir -p "$MUNGE_DIR" "$RUN" "$LOG" "$STATE/ctld" "$STATE/spool"
   chmod 755 "$MUNGE_DIR"  # the socket must be reachable; the key itself is 0600
   # AF_UNIX paths are limited to 107 bytes (slurmstepd sockets live in spool/)
-  [ ${#SOCK} -lt 100 ] && [ $((${#STATE} + 40)) -lt 107 ] \
-    || die "STATE_DIR path too long for Unix sockets: $STATE"
+  if [ $((${#STATE} + 40)) -ge 107 ]; then
+    die "STATE_DIR path too long for Unix sockets (keep it under 66 characters): $STATE"
+  fi
 
-  local user cpus mem node_hw ports p1 p2
+  local user cpus node_hw p1 p2
   user=$(id -un)
   # --- munge: own key, socket, pid, log, seed
   if ! mungekey --create --keyfile="$MUNGE_DIR/munge.key" >/dev/null 2>&1; then
@@ -153,8 +157,7 @@ do_up() {
     --log-file="$LOG/munged.log" --seed-file="$MUNGE_DIR/munged.seed" \
     </dev/null >"$LOG/munged.log" 2>&1 &
   echo $! >"$RUN/munged.pid"
-  local i
-  for i in $(seq 1 50); do [ -S "$SOCK" ] && break; sleep 0.1; done
+  for _ in $(seq 1 50); do [ -S "$SOCK" ] && break; sleep 0.1; done
   if [ ! -S "$SOCK" ] || ! munge -n --socket="$SOCK" | unmunge --socket="$SOCK" >/dev/null 2>&1; then
     tails; do_down; die "munged did not come up (socket $SOCK)"
   fi
@@ -191,7 +194,10 @@ JobCompType=jobcomp/none
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 SchedulerType=sched/backfill
+# a test cluster: start the next tasks at once, not batched every few seconds
+SchedulerParameters=batch_sched_delay=0,sched_min_interval=100000
 MpiDefault=none
+MailProg=/bin/true
 ReturnToService=2
 InactiveLimit=0
 KillWait=5
@@ -202,7 +208,7 @@ EOF
   export SLURM_CONF="$CONF"
 
   # --- daemons, in the foreground of background jobs (pids known at once)
-  setsid slurmctld -D -f "$CONF" -i </dev/null >"$LOG/slurmctld.out" 2>&1 &
+  setsid slurmctld -D -c -f "$CONF" </dev/null >"$LOG/slurmctld.out" 2>&1 &
   echo $! >"$RUN/slurmctld.pid"
   setsid slurmd -D -f "$CONF" -N localhost </dev/null >"$LOG/slurmd.out" 2>&1 &
   echo $! >"$RUN/slurmd.pid"
