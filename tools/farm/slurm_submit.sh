@@ -259,11 +259,20 @@ echo "merge_job=${MERGE_JOB:-none}"
 
 # --- --wait: poll until neither job is queued or running, then read their states
 jobs_ids=$RENDER_JOB${MERGE_JOB:+,$MERGE_JOB}
+errs=0
 while :; do
-  left=$(squeue -h -j "$jobs_ids" -t pending,running,completing,configuring,suspended,requeued,resizing -o %i 2>/dev/null) || left=""
-  [ -z "$left" ] && break
+  if left=$(squeue -h -j "$jobs_ids" -t pending,running,completing,configuring,suspended,requeued,resizing \
+              -o %i 2>"$WORKDIR/logs/.squeue.err"); then
+    errs=0
+    [ -z "$left" ] && break
+  elif grep -qi 'invalid job id' "$WORKDIR/logs/.squeue.err"; then
+    break  # both jobs already purged from the controller: done
+  elif [ $((errs += 1)) -ge 60 ]; then
+    fail "squeue keeps failing: $(cat "$WORKDIR/logs/.squeue.err")"
+  fi
   sleep 1
 done
+rm -f "$WORKDIR/logs/.squeue.err"
 
 # JobState of each job (array tasks: one line each) from scontrol while the
 # controller still remembers them (MinJobAge); logs from the paths above.
