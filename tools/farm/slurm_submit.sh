@@ -113,13 +113,13 @@ OUTDIR=$(dirname "$OUT")
 WORKDIR=$(abspath "${WORKDIR:-$OUTDIR/$NAME.farm}")
 
 # --- the scene: must exist at submit time (its first frame, with --frames)
-frame_path() { # frame_path PATH FRAME: PATH with its first run of '#' replaced by FRAME
-  local p=$1 f=$2
-  if [[ "$p" =~ ^(.*[^#]|)(#+)(.*)$ ]]; then
-    printf '%s%0*d%s' "${BASH_REMATCH[1]}" "${#BASH_REMATCH[2]}" "$f" "${BASH_REMATCH[3]}"
-  else
-    printf %s "$p"
-  fi
+frame_path() { # frame_path PATH FRAME: every run of '#' in PATH replaced by FRAME, zero-padded to the run
+  local p=$1 f=$2 out=""
+  while [[ "$p" =~ ^([^#]*)(#+)(.*)$ ]]; do
+    out+=$(printf '%s%0*d' "${BASH_REMATCH[1]}" "${#BASH_REMATCH[2]}" "$f")
+    p=${BASH_REMATCH[3]}
+  done
+  printf %s "$out$p"
 }
 SCENE=$(abspath "$SCENE")
 if [ "$NFRAMES" -gt 0 ]; then first_scene=$(frame_path "$SCENE" "$FIRST"); else first_scene=$SCENE; fi
