@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # OpenCueDryRun: tools/farm/opencue_job.py compiles, and the commands its
 # --dry-run prints (the frames OpenCue would run, in dependency order: 4 tile
-# frames, then the merge) assemble an image bit-identical to one process.
+# frames, then the merge; then 2 frames x 2 tiles) assemble images
+# bit-identical to one process.
 # OpenCue itself is not run (no Cuebot here): docs/farm-schedulers.md.
 #
 #   bash tests/farm/test_opencue_dryrun.sh [PATH/TO/vdbmarch]
@@ -23,6 +24,19 @@ grep -q 'depend_all on render' "$TMP/job.sh" || { echo "FAIL: the merge layer do
 sh "$TMP/job.sh"
 "$VDBMARCH" render "$SCENE" "${OPTS[@]}" -q -o "$TMP/single.exr"
 "$VDBMARCH" compare "$TMP/out dir/merged.exr" "$TMP/single.exr" --identical
+# frames x tiles (layers render_t0, render_t1 over the frames, merge frame by
+# frame), on a shot whose frames are different volumes
+mkdir -p "$TMP/shot"
+ln -s "$ROOT/vdb_samples/cloud.vdb" "$TMP/shot/vol.0001.vdb"
+ln -s "$ROOT/vdb_samples/plume.vdb" "$TMP/shot/vol.0003.vdb"
+python3 "$ROOT/tools/farm/opencue_job.py" --dry-run --tiles 2 --frames 1-3:2 --vdbmarch "$VDBMARCH" \
+  -o "$TMP/anim/a.####.exr" "$TMP/shot/vol.####.vdb" -- "${OPTS[@]}" >"$TMP/frames.sh"
+grep -q 'frame-by-frame on render_t1' "$TMP/frames.sh" || { echo "FAIL: no frame-by-frame depend"; exit 1; }
+sh "$TMP/frames.sh"
+for f in 1 3; do
+  "$VDBMARCH" render "$TMP/shot/vol.####.vdb" "${OPTS[@]}" --frames "$f" -q -o "$TMP/single.$f.exr"
+  "$VDBMARCH" compare "$TMP/anim/a.000$f.exr" "$TMP/single.$f.exr" --identical
+done
 # argument errors are refused before anything is scheduled
 if python3 "$ROOT/tools/farm/opencue_job.py" --dry-run --frames 1-3 -o "$TMP/x.exr" "$SCENE" 2>/dev/null; then
   echo "FAIL: --frames without #### in the output was accepted"; exit 1

@@ -3,7 +3,8 @@
 # (tools/farm/slurm_local.sh) runs a 4-tile render submitted by
 # tools/farm/slurm_submit.sh; the merged image must be bit-identical to the same
 # render in one process. Also: a failing render task makes --wait fail, the
-# merge is cancelled and no output is written; frames, when vdbmarch has them.
+# merge is cancelled and no output is written; when vdbmarch has --frames, a
+# 2-frame x 2-tile array over a shot whose frames are different volumes.
 # Exit 77 (skipped) only when the Slurm or munge binaries are not installed.
 # Each submission is bounded (timeout 120) so that the trap always brings the
 # cluster down before CTest's TIMEOUT would kill the script.
@@ -86,18 +87,26 @@ grep -q 'merge job [0-9]*: CANCELLED' "$TMP/bad.out" \
 [ ! -e "$TMP/out/bad.exr" ] || { echo "test_slurm: FAIL: an output was written"; exit 1; }
 step "failing tasks reported, merge cancelled"
 
-# --- frames x tiles, when vdbmarch renders frame ranges
+# --- frames x tiles, when vdbmarch renders frame ranges: a shot whose frames
+# are different volumes (frame 1 the cloud, frame 3 the plume), so a tile of
+# one frame merged into another would show
 if "$VDBMARCH" render --help | grep -q -- '--frames'; then
-  step "submitting frames 1-3:2 x 2 tiles"
+  mkdir -p "$TMP/shot"
+  ln -s "$ROOT/vdb_samples/cloud.vdb" "$TMP/shot/vol.0001.vdb"
+  ln -s "$ROOT/vdb_samples/plume.vdb" "$TMP/shot/vol.0003.vdb"
+  step "submitting frames 1-3:2 x 2 tiles of $TMP/shot/vol.####.vdb"
   timeout 120 bash "$ROOT/tools/farm/slurm_submit.sh" --tiles 2 --frames 1-3:2 --wait --vdbmarch "$VDBMARCH" \
-    --workdir "$TMP/fr" -o "$TMP/out/anim.####.exr" "$SCENE" -- "${RENDER_OPTS[@]}"
-  for f in 0001 0003; do
-    "$VDBMARCH" render "$SCENE" "${RENDER_OPTS[@]}" --frames "${f#000}-${f#000}" -q -o "$TMP/single.$f.exr"
-    "$VDBMARCH" compare "$TMP/out/anim.$f.exr" "$TMP/single.$f.exr" --identical \
-      || { echo "test_slurm: FAIL: frame $f differs"; exit 1; }
+    --workdir "$TMP/fr" -o "$TMP/out/anim.####.exr" "$TMP/shot/vol.####.vdb" -- "${RENDER_OPTS[@]}"
+  for f in 1 3; do
+    "$VDBMARCH" render "$TMP/shot/vol.####.vdb" "${RENDER_OPTS[@]}" --frames "$f" -q -o "$TMP/single.000$f.exr"
+    "$VDBMARCH" compare "$TMP/out/anim.000$f.exr" "$TMP/single.000$f.exr" --identical \
+      || { echo "test_slurm: FAIL: frame $f differs from its single-process render"; exit 1; }
   done
+  if "$VDBMARCH" compare "$TMP/out/anim.0001.exr" "$TMP/out/anim.0003.exr" --identical >/dev/null 2>&1; then
+    echo "test_slurm: FAIL: frames 1 and 3 are the same image"; exit 1
+  fi
   [ ! -e "$TMP/out/anim.0002.exr" ] || { echo "test_slurm: FAIL: frame 2 rendered with step 2"; exit 1; }
-  step "frames 1 and 3 bit-identical"
+  step "frames 1 and 3 (2 tiles each) bit-identical to single-process renders"
 else
   step "vdbmarch has no --frames: frame arrays not tested"
 fi
