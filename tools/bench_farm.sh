@@ -7,7 +7,7 @@
 # bit-identical to the one-process image (`compare --identical`; the baked
 # cache variant is checked against a one-process render with that cache).
 # Prints a markdown table; medians over REPEATS runs (default 1).
-# Usage: tools/bench_farm.sh [OUT_DIR] [REPEATS] [THREADS]
+# Usage: [SECTIONS="cloud glass heavy cache"] tools/bench_farm.sh [OUT_DIR] [REPEATS] [THREADS]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out=${1:-$root/bench_out/farm}
@@ -15,6 +15,8 @@ repeats=${2:-1}
 threads=${3:-2}
 bin=$root/build/bin/vdbmarch
 mkdir -p "$out"
+sections=" ${SECTIONS:-cloud glass heavy cache} "
+want() { [[ $sections == *" $1 "* ]]; }
 median() { sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
 
 # cpu CMD...: runs CMD quietly, prints "cpu_seconds wall_seconds".
@@ -74,35 +76,48 @@ tiles() { local n=$1; for i in $(seq 0 $((n - 1))); do printf -- '--tile %d/%d\n
 # 1. The README's cloud (auto: the path tracer, no photons): a tile repeats
 #    only the loading.
 cloud=$root/vdb_samples/cloud.json
-measure_single cloud "$cloud" --spp 16
-for n in 2 4 8; do
-  mapfile -t opts < <(tiles "$n")
-  measure_parts cloud "$cloud" "$n tiles" "${opts[@]}" -- --spp 16
-done
+if want cloud; then
+  measure_single cloud "$cloud" --spp 16
+  for n in 2 4 8; do
+    mapfile -t opts < <(tiles "$n")
+    measure_parts cloud "$cloud" "$n tiles" "${opts[@]}" -- --spp 16
+  done
+fi
 
-# 2. The glass scene (auto: guided, progressive photon passes and a cache):
+# 2. The glass scene with the automatic method (guided: progressive photon
+#    passes and a cache; the scene file itself asks for uniform marching):
 #    every tile traces the photon passes and builds the cache again.
 glass=$root/vdb_samples/glass.json
-gopts=(--spp 16 --set photons.spp_per_pass=4)
-measure_single glass "$glass" "${gopts[@]}"
-for n in 2 4 8; do
-  mapfile -t opts < <(tiles "$n")
-  measure_parts glass "$glass" "$n tiles" "${opts[@]}" -- "${gopts[@]}"
-done
-# Parts by photon passes (4 passes of 4 samples): each part traces its own
-# passes' photons and the cache refinements before it.
-measure_parts glass "$glass" "4 parts by passes" "--passes 0-1" "--passes 1-2" "--passes 2-3" "--passes 3-4" -- "${gopts[@]}"
-measure_parts glass "$glass" "2 parts by passes" "--passes 0-2" "--passes 2-4" -- "${gopts[@]}"
+gopts=(--method auto --res 320x240 --spp 16 --set photons.spp_per_pass=4)
+# split_glass KEY OPTIONS...: tiles and parts by passes of the glass scene.
+split_glass() {
+  local key=$1; shift
+  measure_single "$key" "$glass" "$@"
+  for n in 2 4 8; do
+    mapfile -t opts < <(tiles "$n")
+    measure_parts "$key" "$glass" "$n tiles" "${opts[@]}" -- "$@"
+  done
+  # Parts by photon passes (4 passes of 4 samples): each part traces its own
+  # passes' photons and the cache refinements before it.
+  measure_parts "$key" "$glass" "4 parts by passes" "--passes 0-1" "--passes 1-2" "--passes 2-3" "--passes 3-4" -- "$@"
+  measure_parts "$key" "$glass" "2 parts by passes" "--passes 0-2" "--passes 2-4" -- "$@"
+}
+want glass && split_glass glass "${gopts[@]}"
+# 2b. The same with 10^6 photons per pass (glass.json has 10^5), where the
+#     photons and the cache are a tenth of a one-process render.
+want heavy && split_glass glass_1M_photons "${gopts[@]}" --set photons.count=1000000
 
-# 3. One baked cache shared by the tiles (bake once, render --cache): the
+# 3. One baked cache (10^6 photons) shared by the tiles (bake once, render --cache): the
 #    bake is counted once, in the CPU of the split.
-read -r bake_cpu _ < <(cpu "$bin" bake "$glass" --threads "$threads" -o "$out/glass.cache.vdb")
-measure_single glass_cache "$glass" "${gopts[@]}" --cache "$out/glass.cache.vdb"
-single_cpu[glass_cache]=$(echo "${single_cpu[glass_cache]} + $bake_cpu" | bc -l)
-printf '| (bake, once: %.2f s CPU, counted in both rows above and below) | | | | | |\n' "$bake_cpu"
-for n in 4; do
+want cache || exit 0
+heavy=(--set photons.count=1000000)
+read -r bake_cpu _ < <(cpu "$bin" bake "$glass" --threads "$threads" "${heavy[@]}" -o "$out/glass.cache.vdb")
+measure_single glass_1M_cache "$glass" "${gopts[@]}" "${heavy[@]}" --cache "$out/glass.cache.vdb"
+single_cpu[glass_1M_cache]=$(echo "${single_cpu[glass_1M_cache]} + $bake_cpu" | bc -l)
+printf '| (bake of 10^6 photons, once: %.2f s CPU, counted in the row above and the rows below) | | | | | |\n' "$bake_cpu"
+for n in 4 8; do
   mapfile -t opts < <(tiles "$n")
-  line=$(measure_parts glass_cache "$glass" "$n tiles, one baked cache" "${opts[@]}" -- "${gopts[@]}" --cache "$out/glass.cache.vdb")
-  # add the bake to the parts' CPU
-  echo "$line" | awk -F'|' -v b="$bake_cpu" -v s="${single_cpu[glass_cache]}" 'BEGIN{OFS="|"} {c=$4+b; printf "|%s|%s| %.2f |%s| %.3f |%s|\n", $2, $3, c, $5, c/s, $7}'
+  line=$(measure_parts glass_1M_cache "$glass" "$n tiles, one baked cache" "${opts[@]}" -- "${gopts[@]}" "${heavy[@]}" --cache "$out/glass.cache.vdb")
+  # The bake is part of the split's CPU too.
+  echo "$line" | awk -F'|' -v b="$bake_cpu" -v s="${single_cpu[glass_1M_cache]}" 'BEGIN{OFS="|"} {c=$4+b; printf "|%s|%s| %.2f |%s| %.3f |%s|\n", $2, $3, c, $5, c/s, $7}'
 done

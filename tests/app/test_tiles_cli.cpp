@@ -151,6 +151,37 @@ TEST_F(TilesCli, TimedTilesMergeWithTheirSampleRange) {
     expectCliError(merge({"t0.exr", "t1b.exr"}), {"t1b.exr", "vdbmarch:timeBudget"});
 }
 
+// Shared light transport baked once: tiles that read one baked cache
+// (render --cache) merge bit-identically to one process with that cache,
+// and a tile with another cache is another render.
+TEST_F(TilesCli, TilesSharingABakedCacheMergeBitIdentically) {
+    const std::vector<std::string> common = {"--set", "camera.resolution=[32,24]", "--set", "photons.count=20000",
+                                             "--set", "render.step=0.06"};
+    auto run = [&](std::vector<std::string> args) {
+        args.insert(args.end(), common.begin(), common.end());
+        const CliResult r = cli(args);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+    };
+    const std::string glass = samplePath("glass.json");
+    run({"bake", glass, "-o", "cache.vdb", "-q"});
+    run({"bake", glass, "-o", "other.vdb", "--seed", "2", "-q"});
+    const std::vector<std::string> r = {"render", glass, "--method", "guided", "--spp", "4", "--cache", "cache.vdb", "-q"};
+    auto withOut = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = r;
+        args.insert(args.end(), extra.begin(), extra.end());
+        return args;
+    };
+    run(withOut({"-o", "single.exr", "--threads", "2"}));
+    run(withOut({"-o", "t0.exr", "--tile", "0/2", "--threads", "1"}));
+    run(withOut({"-o", "t1.exr", "--tile", "1/2", "--threads", "2"}));
+    ASSERT_EQ(merge({"t0.exr", "t1.exr"}).exitCode, 0);
+    EXPECT_EQ(identical("merged.exr", "single.exr").exitCode, 0);
+    std::vector<std::string> other = {"render", glass, "--method", "guided", "--spp", "4", "--cache", "other.vdb",
+                                      "--force", "-q", "-o", "t1b.exr", "--tile", "1/2"};
+    run(other);
+    expectCliError(merge({"t0.exr", "t1b.exr"}), {"t1b.exr", "vdbmarch:cache"});
+}
+
 // A progressive render split by photon passes (render --passes): parts
 // rendered apart, each tracing its passes' own photon batches and the cache
 // refinements of the passes before them, merge bit-identically; a missing

@@ -3,7 +3,7 @@
 # --dry-run prints (the frames OpenCue would run, in dependency order: 4 tile
 # frames, then the merge; then 2 frames x 2 tiles) assemble images
 # bit-identical to one process.
-# OpenCue itself is not run (no Cuebot here): docs/farm-schedulers.md.
+# OpenCue itself is not run (no Cuebot here): docs/farm.md.
 #
 #   bash tests/farm/test_opencue_dryrun.sh [PATH/TO/vdbmarch]
 set -euo pipefail

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Submits a tiled (and/or multi-frame) vdbmarch render to OpenCue with PyOutline.
 
-A template, not run here (no Cuebot in this project's CI): docs/farm-schedulers.md.
+A template, not run here (no Cuebot in this project's CI): docs/farm.md.
 
     python3 tools/farm/opencue_job.py [OPTIONS] SCENE -o OUT.exr [-- RENDER_OPTIONS...]
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Submits a vdbmarch render to Slurm: one job array of tile (and frame) renders
-# and one merge job that depends on it (docs/farm-schedulers.md).
+# and one merge job that depends on it (docs/farm.md).
 #
 #   tools/farm/slurm_submit.sh [OPTIONS] SCENE [-- RENDER_OPTIONS...]
 #
