@@ -165,17 +165,47 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // pixel's index in the whole frame.
     const int ww = window.width(), wh = window.height();
     checkImageMemory(ww, wh, rs.aovs);
+    const size_t pixels = size_t(ww) * size_t(wh);
+    const bool timed = options.timeBudget > 0;
+    const AovSet& aovs = rs.aovs;
+    // What the photon passes are (nothing is traced yet), and which samples
+    // this render takes: refused before any buffer is allocated.
+    const IlluminationRequest request = illuminationRequest(scene, rs.method, options.illumination);
+    const PhotonPasses photonPasses(scene, request, w * h);
+    // The passes of the whole render, and the samples of the passes asked for.
+    const int totalPasses = photonPasses.passOf(std::max(0, rs.spp - 1)) + 1;
+    const int totalPhotonPasses = timed ? 0 : totalPasses;
+    int first = 0, last = rs.spp;
+    if (options.passes) {
+        const auto [a, b] = *options.passes;
+        if (timed) throw InputError("--passes and --time: a part of a render by passes renders fixed samples");
+        if (aovs.any())
+            throw InputError(str("--passes ", a, "-", b, " and render.aovs: AOVs are not split by passes; split the "
+                                 "render by tiles instead"));
+        if (!photonPasses.progressive())
+            throw InputError(str("--passes ", a, "-", b, ": this render has no progressive photon passes (method ",
+                                 methodName(rs.method), "): split it by tiles instead"));
+        if (a < 0 || b <= a || b > totalPasses)
+            throw InputError(str("--passes ", a, "-", b, ": this render has passes 0 to ", totalPasses - 1, " (",
+                                 rs.spp, " spp, ", photonPasses.samplesPerPass(), " per pass); the range is FIRST-END "
+                                 "with END excluded, at most ", totalPasses));
+        first = photonPasses.firstSampleOf(a);
+        last = std::min(rs.spp, photonPasses.firstSampleOf(b));
+        // Each pass's sums are kept until written (one EXR layer per pass).
+        checkMemory(uint64_t(b - a) * uint64_t(pixels) * (sizeof(Color) + sizeof(float) + 4 * sizeof(float)),
+                    str("--passes ", a, "-", b, ": the sums of ", b - a, " passes of ", ww, "x", wh, " pixels"));
+    }
+
     const int tilesX = (ww + TileSize - 1) / TileSize, tilesY = (wh + TileSize - 1) / TileSize;
     const int tiles = tilesX * tilesY;
-    const bool timed = options.timeBudget > 0;
     RenderResult result;
     result.window = window;
-    const size_t pixels = size_t(ww) * size_t(wh);
+    result.totalPhotonPasses = totalPhotonPasses;
+    result.firstSample = first;
     PixelSums sums(pixels);
     PassSums open;  // the sums of the pass being rendered
     open.pass = -1;
-    const AovSet& aovs = rs.aovs;
-    AovSums aovSums(aovs, size_t(ww) * size_t(wh));
+    AovSums aovSums(aovs, pixels);
     std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
     ProgressBar progress(options.progress, timed ? 1000 : tiles);
     const int threads = resolveThreadCount(rs.threads);
@@ -186,8 +216,6 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
 
     // Photons and the cache count in the time budget: an equal-time
     // comparison charges the guided marcher for its cache.
-    const IlluminationRequest request = illuminationRequest(scene, rs.method, options.illumination);
-    const PhotonPasses photonPasses(scene, request, w * h);
     std::shared_ptr<Illumination> illumination;
     std::unique_ptr<Marcher> marcher;
     arena.execute([&] {
@@ -287,27 +315,6 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         }
     };
 
-    // The passes of the whole render, and the samples of the passes asked for.
-    const int totalPasses = photonPasses.passOf(std::max(0, rs.spp - 1)) + 1;
-    result.totalPhotonPasses = timed ? 0 : totalPasses;
-    int first = 0, last = rs.spp;
-    if (options.passes) {
-        const auto [a, b] = *options.passes;
-        if (timed) throw InputError("--passes and --time: a part of a render by passes renders fixed samples");
-        if (aovs.any())
-            throw InputError(str("--passes ", a, "-", b, " and render.aovs: AOVs are not split by passes; split the "
-                                 "render by tiles instead"));
-        if (!photonPasses.progressive())
-            throw InputError(str("--passes ", a, "-", b, ": this render has no progressive photon passes (method ",
-                                 methodName(rs.method), "): split it by tiles instead"));
-        if (a < 0 || b <= a || b > totalPasses)
-            throw InputError(str("--passes ", a, "-", b, ": this render has passes 0 to ", totalPasses - 1, " (",
-                                 rs.spp, " spp, ", photonPasses.samplesPerPass(), " per pass); the range is FIRST-END "
-                                 "with END excluded, at most ", totalPasses));
-        first = photonPasses.firstSampleOf(a);
-        last = std::min(rs.spp, photonPasses.firstSampleOf(b));
-    }
-    result.firstSample = first;
 
     int spp = 0;
     if (!timed) {

@@ -216,6 +216,10 @@ TEST_F(TilesCli, PartsByPhotonPassesMergeBitIdentically) {
     expectCliError(cli({"render", samplePath("glass.json"), "--res", "32x24", "--spp", "9", "--method", "guided", "--set",
                         "photons.spp_per_pass=2", "--passes", "3-6", "-o", "x.exr"}),
                    {"--passes 3-6", "passes 0 to 4"});
+    // The sums of every pass a part holds must fit in memory: refused before anything is traced.
+    expectCliError(cli({"render", samplePath("glass.json"), "--res", "1000x1000", "--spp", "100000", "--method", "guided",
+                        "--set", "photons.spp_per_pass=1", "--passes", "0-100000", "-o", "x.exr"}),
+                   {"--passes 0-100000", "the sums of 100000 passes of 1000x1000 pixels"});
     expectCliError(cli({"render", samplePath("cloud.json"), "--method", "reference", "--passes", "0-1", "-o", "x.exr"}),
                    {"--passes 0-1", "no progressive photon passes", "tiles"});
     expectCliError(cli({"render", samplePath("cloud.json"), "--passes", "0-1", "--tile", "0/2", "-o", "x.exr"}),
