@@ -75,7 +75,7 @@ std::vector<ExrLayer> passLayers(const RenderResult& result) {
     for (const PassSums& p : result.passSums) {
         ExrLayer l{str("pass", p.pass), {"R", "G", "B", "T"}, {}};
         l.pixels.reserve(p.L.size() * 4);
-        for (size_t i = 0; i < p.L.size(); ++i) l.pixels.insert(l.pixels.end(), {p.L[i].x, p.L[i].y, p.L[i].z, p.T[i]});
+        for (size_t i = 0; i < p.L.size(); ++i) l.pixels.insert(l.pixels.end(), {p.L[i].x, p.L[i].y, p.L[i].z, float(p.T[i])});
         layers.push_back(std::move(l));
     }
     return layers;

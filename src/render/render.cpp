@@ -120,7 +120,7 @@ std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const std:
 void PixelSums::fold(const PassSums& pass) {
     for (size_t i = 0; i < L.size(); ++i) {
         L[i] += pass.L[i];
-        T[i] += double(pass.T[i]);
+        T[i] += double(float(pass.T[i]));
     }
     samples += pass.samples;
 }
@@ -148,7 +148,7 @@ PixelRect tileOfFrame(int index, int count, int width, int height) {
 
 void checkImageMemory(int width, int height, const AovSet& aovs) {
     // The totals, the open pass's sums, the RGBA result and the AOVs.
-    const uint64_t perPixel = 2 * sizeof(Color) + sizeof(double) + 5 * sizeof(float) + AovSums::bytesPerPixel(aovs);
+    const uint64_t perPixel = 2 * sizeof(Color) + 2 * sizeof(double) + 4 * sizeof(float) + AovSums::bytesPerPixel(aovs);
     checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
@@ -192,7 +192,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         first = photonPasses.firstSampleOf(a);
         last = std::min(rs.spp, photonPasses.firstSampleOf(b));
         // Each pass's sums are kept until written (one EXR layer per pass).
-        checkMemory(uint64_t(b - a) * uint64_t(pixels) * (sizeof(Color) + sizeof(float) + 4 * sizeof(float)),
+        checkMemory(uint64_t(b - a) * uint64_t(pixels) * (sizeof(Color) + sizeof(double) + 4 * sizeof(float)),
                     str("--passes ", a, "-", b, ": the sums of ", b - a, " passes of ", ww, "x", wh, " pixels"));
     }
 
@@ -239,7 +239,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
                             Color& sum = open.L[local];
-                            float& transmittance = open.T[local];
+                            double& transmittance = open.T[local];
                             for (int s = s0; s < s1; ++s) {
                                 Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
                                 float jx = 0.5f, jy = 0.5f;
@@ -291,7 +291,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             closePass();
             open.pass = pass;
             open.L.assign(pixels, Color(0));
-            open.T.assign(pixels, 0.f);
+            open.T.assign(pixels, 0.0);
         }
         open.samples += samples;
     };

@@ -35,13 +35,14 @@ struct RenderOptions {
     std::optional<std::pair<int, int>> passes;
 };
 
-// The sums of one photon pass's samples per pixel: radiance and
-// transmittance, each summed in sample order from zero.
+// The sums of one photon pass's samples per pixel: radiance (float) and
+// transmittance (double, stored and folded as its float rounding, which is
+// what a part file holds), each summed in sample order from zero.
 struct PassSums {
     int pass = 0;
     int samples = 0;
     std::vector<Color> L;
-    std::vector<float> T;
+    std::vector<double> T;
 };
 
 // A render's per-pixel totals. Samples are summed per photon pass and the
