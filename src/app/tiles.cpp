@@ -75,7 +75,10 @@ std::vector<ExrLayer> passLayers(const RenderResult& result) {
     for (const PassSums& p : result.passSums) {
         ExrLayer l{str("pass", p.pass), {"R", "G", "B", "T"}, {}};
         l.pixels.reserve(p.L.size() * 4);
-        for (size_t i = 0; i < p.L.size(); ++i) l.pixels.insert(l.pixels.end(), {p.L[i].x, p.L[i].y, p.L[i].z, float(p.T[i])});
+        for (size_t i = 0; i < p.L.size(); ++i) {
+            const Color c = p.L[i].rounded();
+            l.pixels.insert(l.pixels.end(), {c.x, c.y, c.z, float(p.T[i])});
+        }
         layers.push_back(std::move(l));
     }
     return layers;
@@ -188,7 +191,7 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
         // The file's channels are in name order: B, G, R, T.
         for (size_t i = 0; i < pixels; ++i) {
             const float* v = &layer->pixels[4 * i];
-            pass.L[i] = Color(v[2], v[1], v[0]);
+            pass.L[i] = ColorSum(Color(v[2], v[1], v[0]));
             pass.T[i] = v[3];
         }
         sums.fold(pass);

@@ -119,7 +119,7 @@ std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const std:
 
 void PixelSums::fold(const PassSums& pass) {
     for (size_t i = 0; i < L.size(); ++i) {
-        L[i] += pass.L[i];
+        L[i] += pass.L[i].rounded();
         T[i] += double(float(pass.T[i]));
     }
     samples += pass.samples;
@@ -148,7 +148,7 @@ PixelRect tileOfFrame(int index, int count, int width, int height) {
 
 void checkImageMemory(int width, int height, const AovSet& aovs) {
     // The totals, the open pass's sums, the RGBA result and the AOVs.
-    const uint64_t perPixel = 2 * sizeof(Color) + 2 * sizeof(double) + 4 * sizeof(float) + AovSums::bytesPerPixel(aovs);
+    const uint64_t perPixel = sizeof(Color) + sizeof(ColorSum) + 2 * sizeof(double) + 4 * sizeof(float) + AovSums::bytesPerPixel(aovs);
     checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
@@ -192,7 +192,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         first = photonPasses.firstSampleOf(a);
         last = std::min(rs.spp, photonPasses.firstSampleOf(b));
         // Each pass's sums are kept until written (one EXR layer per pass).
-        checkMemory(uint64_t(b - a) * uint64_t(pixels) * (sizeof(Color) + sizeof(double) + 4 * sizeof(float)),
+        checkMemory(uint64_t(b - a) * uint64_t(pixels) * (sizeof(ColorSum) + sizeof(double) + 4 * sizeof(float)),
                     str("--passes ", a, "-", b, ": the sums of ", b - a, " passes of ", ww, "x", wh, " pixels"));
     }
 
@@ -238,7 +238,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                         for (int x = x0; x < std::min(x0 + TileSize, window.x1); ++x) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
-                            Color& sum = open.L[local];
+                            ColorSum& sum = open.L[local];
                             double& transmittance = open.T[local];
                             for (int s = s0; s < s1; ++s) {
                                 Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
@@ -253,7 +253,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                                     ++ctx.counters.nonFiniteSamples;  // dropped, never written
                                     continue;
                                 }
-                                sum += pr.L;
+                                sum.add(pr.L);
                                 transmittance += pr.transmittance;
                                 if (aovs.any()) {
                                     if (aovs.splitDirect()) aovSums.direct[local] += pr.direct;
@@ -290,7 +290,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         if (open.pass != pass) {
             closePass();
             open.pass = pass;
-            open.L.assign(pixels, Color(0));
+            open.L.assign(pixels, ColorSum());
             open.T.assign(pixels, 0.0);
         }
         open.samples += samples;

@@ -35,13 +35,27 @@ struct RenderOptions {
     std::optional<std::pair<int, int>> passes;
 };
 
-// The sums of one photon pass's samples per pixel: radiance (float) and
-// transmittance (double, stored and folded as its float rounding, which is
-// what a part file holds), each summed in sample order from zero.
+// An RGB sum in double: thousands of samples add up without the float
+// rounding of each addition.
+struct ColorSum {
+    double r = 0, g = 0, b = 0;
+    ColorSum() = default;
+    explicit ColorSum(const Color& c) : r(c.x), g(c.y), b(c.z) {}
+    void add(const Color& c) {
+        r += double(c.x);
+        g += double(c.y);
+        b += double(c.z);
+    }
+    Color rounded() const { return Color(float(r), float(g), float(b)); }
+};
+
+// The sums of one photon pass's samples per pixel, radiance and
+// transmittance, each summed in sample order from zero, in double; a pass is
+// stored (in a part file) and folded as the float rounding of its sums.
 struct PassSums {
     int pass = 0;
     int samples = 0;
-    std::vector<Color> L;
+    std::vector<ColorSum> L;
     std::vector<double> T;
 };
 
