@@ -90,9 +90,9 @@ int main(int argc, char** argv) {
 
     MergeArgs ma;
     CLI::App* merge = app.add_subcommand(
-        "merge", "Assemble the tiles of one render (render --tile / --crop) into the whole frame, checking that they "
-                 "belong together; nothing is written on error");
-    merge->add_option("tiles", ma.tiles, "Tile EXR files")->required();
+        "merge", "Assemble the tiles of one render (render --tile / --crop) into the whole frame, or fold its parts by "
+                 "photon passes (render --passes), checking that they belong together; nothing is written on error");
+    merge->add_option("tiles", ma.tiles, "Tile (or part) EXR files")->required();
     merge->add_option("-o,--output", ma.output, "Output image (.exr)")->required();
     merge->add_option("--png", ma.png, "Also write an sRGB PNG preview");
     merge->add_option("--exposure", ma.exposure, "PNG exposure in stops (default: the scene's render.exposure)");
