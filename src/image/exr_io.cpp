@@ -268,90 +268,77 @@ void writeExr(const std::string& path, const Image& img, const StringAttributes&
     file.commit();
 }
 
-Image readExr(const std::string& path) {
-    return withInputFile(path, [&](Imf::InputFile& in) {
-        const Imath::Box2i dw = in.header().dataWindow();
-        const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
-        std::error_code ec;
-        const uint64_t fileBytes = uint64_t(std::filesystem::file_size(path, ec));
-        checkDataWindowFits(path, w, h, channelCount(in), ec ? UINT64_MAX : fileBytes);
-        checkMemory(uint64_t(w) * uint64_t(h) * 4 * sizeof(float), str("'", path, "' (", w, "x", h, " pixels)"));
-        const Imf::ChannelList& channels = in.header().channels();
-        for (int c = 0; c < 3; ++c)
-            if (!channels.findChannel(RgbaNames[c]))
-                throw InputError(str("'", path, "' has no ", RgbaNames[c], " channel"));
+namespace {
 
-        Image img(static_cast<int>(w), static_cast<int>(h));
-        Imf::FrameBuffer fb;
-        for (int c = 0; c < 4; ++c) {
-            // A missing A channel is filled with 1 (opaque) by OpenEXR.
-            fb.insert(RgbaNames[c], Imf::Slice::Make(Imf::FLOAT, img.rgba.data() + c, dw, 4 * sizeof(float),
-                                                     4 * sizeof(float) * size_t(w), 1, 1, c == 3 ? 1.0 : 0.0));
-        }
-        in.setFrameBuffer(fb);
-        in.readPixels(dw.min.y, dw.max.y);
-        return img;
-    });
+// String attributes of a header, in name order (OpenEXR iterates so).
+StringAttributes stringAttributes(const Imf::Header& header) {
+    StringAttributes out;
+    for (auto it = header.begin(); it != header.end(); ++it)
+        if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) out.emplace_back(it.name(), s->value());
+    return out;
+}
+
+// The data window's R, G, B (A if present, else 1) and, with `allChannels`,
+// every other channel grouped into layers by the name before its last '.',
+// all as FLOAT; both windows; the string attributes.
+ExrContents readContents(const std::string& path, Imf::InputFile& in, bool allChannels) {
+    const Imath::Box2i dw = in.header().dataWindow(), dispw = in.header().displayWindow();
+    const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+    const int channels = channelCount(in);
+    std::error_code ec;
+    const uint64_t fileBytes = uint64_t(std::filesystem::file_size(path, ec));
+    checkDataWindowFits(path, w, h, channels, ec ? UINT64_MAX : fileBytes);
+    const int floatsPerPixel = allChannels ? std::max(4, channels + 1) : 4;
+    checkMemory(uint64_t(w) * uint64_t(h) * uint64_t(floatsPerPixel) * sizeof(float),
+                str("'", path, "' (", w, "x", h, " pixels, ", floatsPerPixel, " floats each)"));
+    const Imf::ChannelList& list = in.header().channels();
+    for (int c = 0; c < 3; ++c)
+        if (!list.findChannel(RgbaNames[c])) throw InputError(str("'", path, "' has no ", RgbaNames[c], " channel"));
+
+    ExrContents out;
+    out.window.data = {dw.min.x, dw.min.y, dw.max.x + 1, dw.max.y + 1};
+    out.window.display = {dispw.min.x, dispw.min.y, dispw.max.x + 1, dispw.max.y + 1};
+    out.image = Image(int(w), int(h));
+    Imf::FrameBuffer fb;
+    // A missing A channel is filled with 1 (opaque) by OpenEXR.
+    for (int c = 0; c < 4; ++c)
+        fb.insert(RgbaNames[c], Imf::Slice::Make(Imf::FLOAT, out.image.rgba.data() + c, dw, 4 * sizeof(float),
+                                                 4 * sizeof(float) * size_t(w), 1, 1, c == 3 ? 1.0 : 0.0));
+    for (auto it = list.begin(); allChannels && it != list.end(); ++it) {
+        const std::string name = it.name();
+        if (name == "R" || name == "G" || name == "B" || name == "A") continue;
+        const size_t dot = name.rfind('.');
+        const std::string layer = dot == std::string::npos ? std::string() : name.substr(0, dot);
+        const std::string channel = dot == std::string::npos ? name : name.substr(dot + 1);
+        if (out.layers.empty() || out.layers.back().name != layer) out.layers.push_back({layer, {}, {}});
+        out.layers.back().channels.push_back(channel);
+    }
+    for (ExrLayer& l : out.layers) {
+        const size_t n = l.channels.size();
+        l.pixels.assign(size_t(w) * size_t(h) * n, 0.f);
+        for (size_t c = 0; c < n; ++c)
+            fb.insert(l.name.empty() ? l.channels[c] : l.name + "." + l.channels[c],
+                      Imf::Slice::Make(Imf::FLOAT, l.pixels.data() + c, dw, n * sizeof(float),
+                                       n * sizeof(float) * size_t(w)));
+    }
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+    out.attributes = stringAttributes(in.header());
+    return out;
+}
+
+}  // namespace
+
+Image readExr(const std::string& path) {
+    return withInputFile(path, [&](Imf::InputFile& in) { return readContents(path, in, false).image; });
 }
 
 ExrContents readExrContents(const std::string& path) {
-    return withInputFile(path, [&](Imf::InputFile& in) {
-        const Imath::Box2i dw = in.header().dataWindow(), dispw = in.header().displayWindow();
-        const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
-        const int channels = channelCount(in);
-        std::error_code ec;
-        const uint64_t fileBytes = uint64_t(std::filesystem::file_size(path, ec));
-        checkDataWindowFits(path, w, h, channels, ec ? UINT64_MAX : fileBytes);
-        checkMemory(uint64_t(w) * uint64_t(h) * uint64_t(std::max(4, channels + 1)) * sizeof(float),
-                    str("'", path, "' (", w, "x", h, " pixels, ", channels, " channels)"));
-        const Imf::ChannelList& list = in.header().channels();
-        for (int c = 0; c < 3; ++c)
-            if (!list.findChannel(RgbaNames[c])) throw InputError(str("'", path, "' has no ", RgbaNames[c], " channel"));
-
-        ExrContents out;
-        out.window.data = {dw.min.x, dw.min.y, dw.max.x + 1, dw.max.y + 1};
-        out.window.display = {dispw.min.x, dispw.min.y, dispw.max.x + 1, dispw.max.y + 1};
-        out.image = Image(int(w), int(h));
-        Imf::FrameBuffer fb;
-        for (int c = 0; c < 4; ++c)
-            fb.insert(RgbaNames[c], Imf::Slice::Make(Imf::FLOAT, out.image.rgba.data() + c, dw, 4 * sizeof(float),
-                                                     4 * sizeof(float) * size_t(w), 1, 1, c == 3 ? 1.0 : 0.0));
-        // The other channels, grouped into layers by the name before the last '.'.
-        for (auto it = list.begin(); it != list.end(); ++it) {
-            const std::string name = it.name();
-            if (name == "R" || name == "G" || name == "B" || name == "A") continue;
-            const size_t dot = name.rfind('.');
-            const std::string layer = dot == std::string::npos ? std::string() : name.substr(0, dot);
-            const std::string channel = dot == std::string::npos ? name : name.substr(dot + 1);
-            if (out.layers.empty() || out.layers.back().name != layer) out.layers.push_back({layer, {}, {}});
-            out.layers.back().channels.push_back(channel);
-        }
-        for (ExrLayer& l : out.layers) {
-            const size_t n = l.channels.size();
-            l.pixels.assign(size_t(w) * size_t(h) * n, 0.f);
-            for (size_t c = 0; c < n; ++c)
-                fb.insert(l.name.empty() ? l.channels[c] : l.name + "." + l.channels[c],
-                          Imf::Slice::Make(Imf::FLOAT, l.pixels.data() + c, dw, n * sizeof(float),
-                                           n * sizeof(float) * size_t(w)));
-        }
-        in.setFrameBuffer(fb);
-        in.readPixels(dw.min.y, dw.max.y);
-        for (auto it = in.header().begin(); it != in.header().end(); ++it)
-            if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
-                out.attributes.emplace_back(it.name(), s->value());
-        return out;
-    });
+    return withInputFile(path, [&](Imf::InputFile& in) { return readContents(path, in, true); });
 }
 
 StringAttributes readExrStringAttributes(const std::string& path) {
-    return withInputFile(path, [](Imf::InputFile& in) {
-        StringAttributes out;
-        // Header iteration is in name order.
-        for (auto it = in.header().begin(); it != in.header().end(); ++it)
-            if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
-                out.emplace_back(it.name(), s->value());
-        return out;
-    });
+    return withInputFile(path, [](Imf::InputFile& in) { return stringAttributes(in.header()); });
 }
 
 }  // namespace vdbmarch
