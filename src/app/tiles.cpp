@@ -127,17 +127,35 @@ bool perTileAttribute(const std::string& name, bool timed, bool byPasses) {
 }
 
 // The attributes of the merged frame: the first tile's, without the tile's
-// own, with the total time and `replaced` values.
-StringAttributes mergedAttributes(const Tile& ref, size_t tiles, double seconds,
-                                  const std::map<std::string, std::string>& replaced) {
+// own, with the tiles' total time and `replaced` values.
+StringAttributes mergedAttributes(const std::vector<Tile>& tiles, const std::map<std::string, std::string>& replaced) {
+    const Tile& ref = tiles.front();
+    double seconds = 0;
+    for (const Tile& t : tiles) seconds += std::atof(t.attribute("vdbmarch:renderSeconds").c_str());
     StringAttributes out;
     for (const auto& [k, v] : ref.contents.attributes) {
         if (k == TileSplitAttribute || k == TileAttribute || k == PassSamplesAttribute) continue;
         auto it = replaced.find(k);
         out.emplace_back(k, k == "vdbmarch:renderSeconds" ? str(seconds) : it != replaced.end() ? it->second : v);
     }
-    out.emplace_back("vdbmarch:mergedFrom", str(tiles, " tiles (", ref.attribute(TileSplitAttribute), ")"));
+    out.emplace_back("vdbmarch:mergedFrom", str(tiles.size(), " tiles (", ref.attribute(TileSplitAttribute), ")"));
     return out;
+}
+
+// "merge: 2 of 8 <what> missing: a, b; nothing written" for the indices in
+// [0, count) that `present` lacks (the first 8 named by `name`); "" if none.
+template <class Name>
+std::string missingMessage(const std::vector<bool>& present, const char* what, Name name) {
+    std::string list;
+    int n = 0;
+    for (size_t i = 0; i < present.size(); ++i)
+        if (!present[i]) {
+            if (n < 8) list += str(n ? ", " : "", name(int(i)));
+            ++n;
+        }
+    return n ? str("merge: ", n, " of ", present.size(), " ", what, " missing: ", list, n > 8 ? ", ..." : "",
+                   "; nothing written")
+             : std::string();
 }
 
 // Parts by passes: every pass of the render once, folded in pass order into
@@ -159,19 +177,12 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
             owner[size_t(p)] = &t;
         }
     }
-    std::string missing;
-    int n = 0;
-    for (int p = 0; p < total; ++p)
-        if (!owner[size_t(p)]) {
-            if (n < 8) missing += str(n ? ", " : "", p);
-            ++n;
-        }
-    if (n) throw InputError(str("merge: ", n, " of ", total, " photon passes missing: ", missing, n > 8 ? ", ..." : "",
-                                "; nothing written"));
+    std::vector<bool> present(static_cast<size_t>(total), false);
+    for (int p = 0; p < total; ++p) present[size_t(p)] = owner[size_t(p)] != nullptr;
+    const std::string missing = missingMessage(present, "photon passes", [](int p) { return str(p); });
+    if (!missing.empty()) throw InputError(missing);
     const size_t pixels = size_t(frame.width()) * size_t(frame.height());
     PixelSums sums(pixels);
-    double seconds = 0;
-    for (const Tile& t : parts) seconds += std::atof(t.attribute("vdbmarch:renderSeconds").c_str());
     for (int p = 0; p < total; ++p) {
         const Tile& t = *owner[size_t(p)];
         const std::string name = str("pass", p);
@@ -199,7 +210,7 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
     MergedTiles out;
     out.frame.image = sums.average(frame.width(), frame.height());
     out.frame.window = {frame, frame};
-    out.frame.attributes = mergedAttributes(ref, parts.size(), seconds,
+    out.frame.attributes = mergedAttributes(parts,
                                             {{"vdbmarch:spp", str(sums.samples)}, {"vdbmarch:photonPasses", str(total)}});
     return out;
 }
@@ -323,16 +334,10 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
         if (ref.count > 0) {
             std::vector<bool> present(size_t(ref.count), false);
             for (const Tile& t : tiles) present[size_t(t.index)] = true;
-            std::string missing;
-            int n = 0;
-            for (int i = 0; i < ref.count; ++i)
-                if (!present[size_t(i)]) {
-                    const PixelRect r = tileOfFrame(i, ref.count, frame.width(), frame.height());
-                    if (n < 8) missing += str(n ? ", " : "", i, "/", ref.count, " (rows ", r.y0, "-", r.y1 - 1, ")");
-                    ++n;
-                }
-            throw InputError(str("merge: ", n, " of ", ref.count, " tiles missing: ", missing, n > 8 ? ", ..." : "",
-                                 "; nothing written"));
+            throw InputError(missingMessage(present, "tiles", [&](int i) {
+                const PixelRect r = tileOfFrame(i, ref.count, frame.width(), frame.height());
+                return str(i, "/", ref.count, " (rows ", r.y0, "-", r.y1 - 1, ")");
+            }));
         }
         checkMemory(framePixels, "the coverage map of the frame");
         std::vector<char> hit(framePixels, 0);
@@ -357,7 +362,6 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
     m.window = {frame, frame};
     for (const ExrLayer& l : ref.contents.layers)
         m.layers.push_back({l.name, l.channels, std::vector<float>(framePixels * l.channels.size())});
-    double seconds = 0;
     for (const Tile& t : tiles) {
         const PixelRect& d = t.contents.window.data;
         auto copyRows = [&](const std::vector<float>& from, std::vector<float>& to, size_t n) {
@@ -368,12 +372,11 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
         copyRows(t.contents.image.rgba, m.image.rgba, 4);
         for (size_t i = 0; i < m.layers.size(); ++i)
             copyRows(t.contents.layers[i].pixels, m.layers[i].pixels, m.layers[i].channels.size());
-        seconds += std::atof(t.attribute("vdbmarch:renderSeconds").c_str());
     }
     std::map<std::string, std::string> replaced;
     if (timed)
         for (const char* k : {"vdbmarch:spp", "vdbmarch:photonPasses"}) replaced[k] = valueRange(tiles, k);
-    m.attributes = mergedAttributes(ref, tiles.size(), seconds, replaced);
+    m.attributes = mergedAttributes(tiles, replaced);
     if (timed && valueRange(tiles, "vdbmarch:spp").find('-') != std::string::npos)
         out.warnings.push_back(str("the tiles were rendered with a time budget and reached ", valueRange(tiles, "vdbmarch:spp"),
                                    " samples per pixel: noise (and, with photons, bias) may differ between tiles"));
