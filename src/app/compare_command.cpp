@@ -38,9 +38,10 @@ int compareIdentical(const CompareArgs& a) {
             for (const std::string& ch : l.channels) s += l.name + "." + ch + " ";
         return s;
     };
-    if (layerNames(t) != layerNames(r)) {
-        std::printf("identical no\nchannels differ: %s(%s) against %s(%s)\n", layerNames(t).c_str(), a.test.c_str(),
-                    layerNames(r).c_str(), a.reference.c_str());
+    const std::string testChannels = layerNames(t), referenceChannels = layerNames(r);
+    if (testChannels != referenceChannels) {
+        std::printf("identical no\nchannels differ: %s(%s) against %s(%s)\n", testChannels.c_str(), a.test.c_str(),
+                    referenceChannels.c_str(), a.reference.c_str());
         return 1;
     }
     for (size_t i = 0; i < t.layers.size(); ++i) {
