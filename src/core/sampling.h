@@ -61,4 +61,44 @@ inline float fresnelDielectric(float cosI, float eta, float* cosTOut = nullptr) 
     return 0.5f * (rPar * rPar + rPerp * rPerp);
 }
 
+// Equiangular distance sampling (Kulla & Fajardo 2012, "Importance Sampling
+// Techniques for Path Tracing in Participating Media"): t in [a, b] along
+// the ray o + t d (d unit) with density proportional to 1 / r(t)^2, r the
+// distance to a point c, the falloff of a light at c. With delta the
+// parameter of c's foot on the ray and D the distance of c from the ray,
+// t = delta + D tan(theta) with theta uniform between the angles of a and b.
+// D is kept at least minDistance (a ray through the point itself). Double
+// inside: tan near +-pi/2 and far intervals lose float digits.
+class EquiangularSampler {
+public:
+    EquiangularSampler() = default;
+    EquiangularSampler(const Vec3& o, const Vec3& d, const Vec3& c, float a, float b, float minDistance) {
+        const Vec3 oc = c - o;
+        mDelta = double(dot(oc, d));
+        const Vec3 perp = oc - d * float(mDelta);
+        mD = std::max(double(length(perp)), double(minDistance));
+        mA = a;
+        mB = b;
+        mThetaA = std::atan2(double(a) - mDelta, mD);
+        mThetaB = std::isinf(b) ? 0.5 * 3.14159265358979323846 : std::atan2(double(b) - mDelta, mD);
+        mValid = b > a && mThetaB > mThetaA && mD > 0;
+    }
+    bool valid() const { return mValid; }
+    float sample(float u) const {
+        const double t = mDelta + mD * std::tan(mThetaA + double(u) * (mThetaB - mThetaA));
+        return clamp(float(t), mA, mB);
+    }
+    // Density of sample() at t; 0 outside [a, b].
+    float pdf(float t) const {
+        if (!mValid || !(t >= mA && t <= mB)) return 0.f;
+        const double x = double(t) - mDelta;
+        return float(mD / ((mThetaB - mThetaA) * (mD * mD + x * x)));
+    }
+
+private:
+    double mDelta = 0, mD = 1, mThetaA = 0, mThetaB = 0;
+    float mA = 0, mB = 0;
+    bool mValid = false;
+};
+
 }  // namespace vdbmarch

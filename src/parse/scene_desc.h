@@ -80,6 +80,12 @@ struct AovSet {
 // The names render.aovs accepts, in documentation order.
 const std::vector<std::string>& aovNames();
 
+// How free flights in media find point, spot and sphere lights (Cycles'
+// "volume sampling"): by transmittance alone (delta tracking), by distance
+// sampling towards each light (equiangular) alone, or by both weighed by
+// multiple importance sampling (transport/light_distance.h).
+enum class VolumeSampling { Distance, Equiangular, Mis };
+
 struct RenderSettings {
     Method method = Method::Uniform;
     // render.method = "auto" (the default): `method` is chosen from what the
@@ -103,6 +109,7 @@ struct RenderSettings {
     // from phase x cached radiance (cache/product_sampler.h), else the phase.
     bool productSampling = false;  // measured slower to converge on cloud_sun and exp1_sphere (BENCHMARKS.md)
     AovSet aovs;  // none by default: the EXR holds RGBA only
+    VolumeSampling volumeSampling = VolumeSampling::Mis;
 };
 
 // The volume photon map (scene key "photons").

@@ -315,7 +315,8 @@ AovSet parseAovs(const JsonReader& r) {
 
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
-                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "aovs"});
+                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "aovs",
+                 "volume_sampling"});
     RenderSettings s;
     {
         std::vector<std::string> names = {"auto"};
@@ -343,6 +344,11 @@ RenderSettings parseRender(const JsonReader& r) {
     s.productSampling = r.boolean("product_sampling", s.productSampling);
     s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
     if (r.has("aovs")) s.aovs = parseAovs(r);
+    {
+        const std::string v = r.choice("volume_sampling", "mis", {"mis", "distance", "equiangular"});
+        s.volumeSampling = v == "distance" ? VolumeSampling::Distance
+                           : v == "equiangular" ? VolumeSampling::Equiangular : VolumeSampling::Mis;
+    }
     return s;
 }
 

@@ -102,6 +102,55 @@ bool Light::sample(const Vec3& x, float u1, float u2, LightSample& s) const {
     return false;
 }
 
+bool Light::reachInterval(const Ray& r, float& t0, float& t1) const {
+    t0 = 0;
+    t1 = Infinity;
+    if (mDesc.type != LightDesc::Type::Spot) return true;
+    // Points x = o + t d inside the cone: cos(x - p, axis) > cos(cone). On
+    // the cone's surface (both nappes) f(t) = (a.v + t a.d)^2 - c2 |v + t d|^2
+    // vanishes (v = o - p, a the axis, c2 = cos^2): a quadratic whose roots
+    // cut the ray into at most three pieces, each wholly in or out.
+    const Vec3& a = mDesc.direction;
+    const Vec3 v = r.o - mDesc.position;
+    const double c = mCosCone, c2 = c * c;
+    const double av = dot(a, v), ad = dot(a, r.d), vd = dot(v, r.d), vv = lengthSquared(v), dd = lengthSquared(r.d);
+    const double A = ad * ad - c2 * dd, B = 2 * (av * ad - c2 * vd), C = av * av - c2 * vv;
+    double cuts[4];
+    int n = 0;
+    cuts[n++] = 0;
+    if (std::fabs(A) > 1e-12 * (std::fabs(B) + std::fabs(C) + 1e-30)) {
+        const double disc = B * B - 4 * A * C;
+        if (disc >= 0) {
+            const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+            double r0 = q / A, r1 = q != 0 ? C / q : r0;
+            if (r0 > r1) std::swap(r0, r1);
+            if (r0 > 0) cuts[n++] = r0;
+            if (r1 > 0 && r1 > cuts[n - 1]) cuts[n++] = r1;
+        }
+    } else if (B != 0 && -C / B > 0) {
+        cuts[n++] = -C / B;
+    }
+    // Each piece is in or out as its middle point (or, for the unbounded
+    // last piece, a point past its start) is.
+    auto inside = [&](double t) {
+        const Vec3 x = r.at(t) - mDesc.position;
+        const float len = length(x);
+        return len > 0 && dot(x, a) > mCosCone * len;
+    };
+    double lo = Infinity, hi = -1;
+    for (int i = 0; i < n; ++i) {
+        const double s = cuts[i], e = i + 1 < n ? cuts[i + 1] : double(Infinity);
+        const double probe = std::isinf(e) ? s + std::max(1.0, 2 * s) : 0.5 * (s + e);
+        if (!inside(probe)) continue;
+        lo = std::min(lo, s);
+        hi = std::max(hi, e);
+    }
+    if (!(hi > lo)) return false;
+    t0 = float(lo);
+    t1 = std::isinf(hi) ? Infinity : float(hi);
+    return true;
+}
+
 bool Light::intersect(const Ray& r, float tMin, float tMax, float& t) const {
     if (mDesc.type != LightDesc::Type::Sphere) return false;
     Vec3 oc = r.o - mDesc.position;

@@ -27,6 +27,12 @@ public:
     // A point or spot light: its irradiance grows as 1/d^2 close to it, so
     // next-event estimation at scattering vertices around it has unbounded variance.
     bool isPointLike() const { return mDesc.type == LightDesc::Type::Point || mDesc.type == LightDesc::Type::Spot; }
+    // The part [t0, t1] of the ray r (t >= 0) that the light can reach: a
+    // spot's cone (the hull of its two pieces when the cone is wider than a
+    // hemisphere), all of the ray for other lights. False when the ray never
+    // enters the light's reach. Distance sampling towards the light only
+    // draws points there.
+    bool reachInterval(const Ray& r, float& t0, float& t1) const;
     // Sphere lights only: nearest hit in (tMin, tMax).
     bool intersect(const Ray& r, float tMin, float tMax, float& t) const;
     // Radiance leaving a sphere light's surface: power / (4 pi^2 r^2).

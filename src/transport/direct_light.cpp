@@ -34,16 +34,21 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         nf = dot(v.n, v.d) < 0 ? v.n : -v.n;
         origin = v.p + nf * (1e-5f * std::max(scene.sceneScale, maxComponent(max(v.p, -v.p))));
     }
-    for (const Light& light : scene.lights) {
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        const Light& light = scene.lights[i];
+        if (o.onlyLight >= 0 && int(i) != o.onlyLight) continue;
         if (o.skipPointLights && light.isPointLike()) continue;
+        const float lightWeight = o.lightWeights ? o.lightWeights[i] : 1.f;
+        if (!(lightWeight > 0)) continue;
         LightSample ls;
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;
         const Color f = v.f(ls.wi);
         if (isBlack(f)) continue;
         const float w = o.misWithPathHits && light.isSphere() ? powerHeuristic(ls.pdf, v.pdf(ls.wi)) : 1.f;
-        L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) * w;
+        L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) * (w * lightWeight);
     }
+    if (o.onlyLight >= 0) return L;
     const Environment& env = scene.environment;
     // An environment map is a light: sampled by its texel power, weighed by
     // the power heuristic against the direction sampling of f, done by the

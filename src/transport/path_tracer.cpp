@@ -2,6 +2,7 @@
 
 #include "core/sampling.h"
 #include "transport/direct_light.h"
+#include "transport/light_distance.h"
 #include "transport/media_point.h"
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
@@ -14,8 +15,8 @@ namespace {
 // Next-event estimation of the path: ratio tracking; sphere lights are also
 // hit by the path, a constant background only by the path, an environment
 // map by both.
-DirectLightOptions nextEventOptions(const PathState& st) {
-    return {TransmittanceEstimator::RatioTracking, true, false, st.pointLightsByPhotons};
+DirectLightOptions nextEventOptions(const PathState& st, const float* lightWeights = nullptr) {
+    return {TransmittanceEstimator::RatioTracking, true, false, st.pointLightsByPhotons, lightWeights};
 }
 
 // Russian roulette on the throughput after RouletteMinDepth events.
@@ -38,12 +39,15 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     const int maxDepth = scene.desc.render.maxDepth;
     const int startDepth = st.depth;
     Color L(0), beta(1);
-    // L when the path's second scattering event happened: the direct part
-    // (one copy per path, so the AOV costs nothing per contribution).
+    // The "direct" part: what arrives after at most one scattering event in
+    // all. `events` is the number of events the contribution has been
+    // through (a next-event estimate at a vertex counts that vertex).
     Color direct(0);
-    auto result = [&](float transmittance) {
-        return PathRadiance{L, transmittance, st.depth <= 1 ? L : direct};
+    auto add = [&](const Color& c, int events) {
+        L += c;
+        if (events <= 1) direct += c;
     };
+    auto result = [&](float transmittance) { return PathRadiance{L, transmittance, direct}; };
     int surfaceBounces = 0;
     MediumPoint mp;
     while (true) {
@@ -53,6 +57,14 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
         float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
 
+        // Distance sampling towards point, spot and sphere lights along the
+        // segment, weighed against the tracking collisions' next-event
+        // estimates by MIS (light_distance.h).
+        const LightDistanceSegment lightDistances =
+            st.depth < maxDepth ? prepareLightDistances(ctx, region, ray, tEnd, channel, st.pointLightsByPhotons)
+                                : LightDistanceSegment{};
+        if (lightDistances.any()) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
+
         // Delta tracking to the next real collision, or to tEnd; the
         // collision callback returns false once the path scattered or was absorbed.
         bool scattered = false;
@@ -60,7 +72,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             evalMedia(ctx, region, x, mp);
             ++ctx.counters.marchSamples;
             // Emission: sigma_a L_e / sigma_maj at every tentative collision.
-            if (!isBlack(mp.emission)) L += beta * mp.sigma_a * mp.emission / sigmaMaj;
+            if (!isBlack(mp.emission)) add(beta * mp.sigma_a * mp.emission / sigmaMaj, st.depth);
             float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
             float u = rng.uniform() * sigmaMaj;
             if (u < sa) {
@@ -70,12 +82,15 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             if (u >= sa + ss) return true;  // null collision
             // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
             beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
-            if (++st.depth == 2) direct = L;
-            if (st.depth > maxDepth) {
+            if (++st.depth > maxDepth) {
                 beta = Color(0);
                 return false;
             }
-            L += beta * directLight(ctx, region, ScatterVertex::inMedium(x, ray.d, mp.phase), rng, nextEventOptions(st));
+            const float* weights =
+                lightDistances.any() ? trackingWeights(ctx, lightDistances, dot(x - ray.o, ray.d), mp) : nullptr;
+            add(beta * directLight(ctx, region, ScatterVertex::inMedium(x, ray.d, mp.phase), rng,
+                                   nextEventOptions(st, weights)),
+                st.depth);
             float pdf;
             const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
             Vec3 wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
@@ -102,7 +117,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 float sin2 = r2 / d2, cosMax = sin2 < 1e-6f ? 1 - 0.5f * sin2 : safeSqrt(1 - sin2);
                 w = powerHeuristic(st.lastPdf, uniformConePdf(cosMax));
             }
-            L += beta * l.emittedRadiance() * w;
+            add(beta * l.emittedRadiance() * w, st.depth);
             return result(0.f);
         }
         if (!hit) {
@@ -111,7 +126,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const Environment& env = scene.environment;
             const float w = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(ray.d)) : 1.f;
             // A camera path that never scattered sees the map as a backdrop.
-            L += beta * (st.depth == 0 ? env.radianceSeen(ray.d) : env.radiance(ray.d)) * w;
+            add(beta * (st.depth == 0 ? env.radianceSeen(ray.d) : env.radiance(ray.d)) * w, st.depth);
             return result(st.depth == startDepth && surfaceBounces == 0 ? average(beta) : 0.f);
         }
         ++ctx.counters.surfaceHits;
@@ -119,10 +134,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
         const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
-            if (++st.depth == 2) direct = L;
-            if (st.depth > maxDepth) return result(0.f);
+            if (++st.depth > maxDepth) return result(0.f);
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            L += beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, nextEventOptions(st));
+            add(beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng,
+                                   nextEventOptions(st)),
+                st.depth);
             st.lastPdf = e.pdf;
             st.specular = false;
             st.lastPoint = h.p;

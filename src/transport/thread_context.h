@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/sampling.h"
 #include "core/stats.h"
 #include "scene/scene.h"
 
@@ -22,6 +23,19 @@ struct ThreadContext {
     std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
     std::vector<Interval> intervals, shadowIntervals, scratch;
     std::vector<MajorantSegment> majorants;
+    // Distance sampling towards lights along the current path segment
+    // (light_distance.h), and next-event weights per light.
+    struct LightDistance {
+        int light;
+        EquiangularSampler sampler;
+    };
+    std::vector<LightDistance> lightDistances;
+    std::vector<float> lightWeights;
+    // The region each light sits in, and whether some surface blocks shadow
+    // rays: a light in another region behind such a surface gets no
+    // distance samples (its shadow rays would mostly be blocked).
+    std::vector<int> lightRegions;
+    bool blockingSurfaces = false;
     RenderCounters counters;
     std::unique_ptr<ThreadContextExtension> extension;
 

@@ -94,6 +94,10 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
 
 }  // namespace
 
+Color regionTransmittance(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng) {
+    return ratioTracking(ctx, region, r, tEnd, rng);
+}
+
 Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const Vec3& wi, float dist, Rng& rng,
                           TransmittanceEstimator estimator) {
     ++ctx.counters.shadowRays;

@@ -50,4 +50,8 @@ enum class TransmittanceEstimator {
 Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const Vec3& wi, float dist, Rng& rng,
                           TransmittanceEstimator estimator);
 
+// Transmittance along [0, tEnd) of ray r inside `region` (no surface in
+// between), by ratio tracking: unbiased; constant media exactly.
+Color regionTransmittance(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng);
+
 }  // namespace vdbmarch

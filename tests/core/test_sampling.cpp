@@ -68,5 +68,61 @@ TEST(Fresnel, NormalIncidenceAndTotalInternalReflection) {
     EXPECT_NEAR(fresnelDielectric(1e-6f, n), 1.f, 1e-3);  // grazing
 }
 
+// Equiangular distance sampling: the pdf integrates to 1 over [a, b]
+// (midpoint quadrature), and samples pass a chi-square test against the pdf
+// integrated over each bin, for a point beside the interval, one near its
+// middle (a sharp peak) and one far from it, and a half-infinite interval.
+struct EquiangularCase {
+    Vec3 light;
+    float a, b;
+};
+
+class Equiangular : public ::testing::TestWithParam<EquiangularCase> {};
+
+TEST_P(Equiangular, PdfIntegratesToOneAndSamplerPassesChiSquare) {
+    const EquiangularCase c = GetParam();
+    const Vec3 o(0.1f, -0.2f, 0.3f), d = normalize(Vec3(1, 0.5f, -0.25f));
+    EquiangularSampler s(o, d, c.light, c.a, c.b, 1e-6f);
+    ASSERT_TRUE(s.valid());
+    // Bins over [a, B]: B = b, or for b = inf a far point whose tail mass is
+    // in the last pooled bin.
+    const double B = std::isinf(c.b) ? c.a + 200.0 : c.b;
+    const int bins = 400, samples = 400000;
+    auto binMass = [&](int k) {  // fine midpoint quadrature of the pdf over bin k
+        const int sub = 400;
+        const double t0 = c.a + (B - c.a) * k / bins, h = (B - c.a) / bins / sub;
+        double m = 0;
+        for (int i = 0; i < sub; ++i) m += double(s.pdf(float(t0 + (i + 0.5) * h))) * h;
+        return m;
+    };
+    std::vector<double> observed(bins + 1, 0), expected(bins + 1, 0);
+    double total = 0;
+    for (int k = 0; k < bins; ++k) total += expected[size_t(k)] = binMass(k);
+    if (std::isinf(c.b)) {
+        expected[bins] = std::max(0.0, 1 - total);
+    } else {
+        EXPECT_NEAR(total, 1.0, 2e-3);
+    }
+    for (double& e : expected) e *= samples;
+    Rng rng(7, 11);
+    for (int i = 0; i < samples; ++i) {
+        const float t = s.sample(rng.uniform());
+        ASSERT_GE(t, c.a);
+        ASSERT_LE(t, c.b);
+        const int k = t >= B ? bins : std::min(bins - 1, int((t - c.a) / (B - c.a) * bins));
+        observed[size_t(k)] += 1;
+    }
+    test::ChiSquare chi = test::pooledChiSquare(observed, expected, 5);
+    EXPECT_GT(chi.p(), 1e-4) << "chi2 " << chi.chi2 << " dof " << chi.dof;
+    EXPECT_EQ(s.pdf(c.a - 0.01f), 0.f);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Lights, Equiangular,
+    ::testing::Values(EquiangularCase{Vec3(3, 2, 1), 0.5f, 6.f},           // beside the interval
+                      EquiangularCase{Vec3(1.8f, 0.7f, -0.1f), 0.f, 4.f},  // 0.1 from the ray: a sharp peak
+                      EquiangularCase{Vec3(-40, 3, 0), 1.f, 5.f},           // far behind: nearly uniform
+                      EquiangularCase{Vec3(2, 1.5f, 0), 0.f, Infinity}));  // half-infinite
+
 }  // namespace
 }  // namespace vdbmarch

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/rng.h"
+#include "core/sampling.h"
 #include "scene/lights.h"
 #include "support/support.h"
 
@@ -58,6 +59,51 @@ TEST(CollimatedQuad, LightsOnlyItsBeam) {
     EXPECT_EQ(ls.L.x, 3);
     EXPECT_FALSE(light.sample(Vec3(1.1f, 0, 0), 0, 0, ls));  // beside the quad
     EXPECT_FALSE(light.sample(Vec3(0, 6, 0), 0, 0, ls));     // above the emitter
+}
+
+// A spot's reach along a ray (the interval distance sampling draws from)
+// against a brute-force walk of the ray, for narrow, wide and
+// wider-than-a-hemisphere cones, rays that start inside, outside and at the
+// apex. The interval must hold every lit point (it may be a hull).
+TEST(SpotLight, ReachIntervalHoldsEveryLitPointOfTheRay) {
+    Rng rng(3, 4);
+    int withLight = 0;
+    for (float cone : {7.f, 30.f, 89.f, 120.f, 180.f}) {
+        Light light(spotLight(Vec3(0.2f, 1, -0.5f), normalize(Vec3(0.3f, -1, 0.2f)), cone, 0, Color(1)));
+        for (int i = 0; i < 400; ++i) {
+            Vec3 o = i % 50 == 0 ? light.desc().position
+                                 : Vec3(rng.uniform() * 4 - 2, rng.uniform() * 4 - 2, rng.uniform() * 4 - 2);
+            const Vec3 d = sampleUniformSphere(rng.uniform(), rng.uniform());
+            const Ray r{o, d};
+            float t0 = -1, t1 = -1;
+            const bool any = light.reachInterval(r, t0, t1);
+            // Lit points on a fine walk of [0, 20].
+            float lo = Infinity, hi = -1;
+            for (int k = 0; k <= 20000; ++k) {
+                const float t = 20.f * float(k) / 20000;
+                LightSample ls;
+                if (light.sample(r.at(t), 0, 0, ls) && ls.L.x > 0) {
+                    lo = std::min(lo, t);
+                    hi = std::max(hi, t);
+                }
+            }
+            if (hi < 0) continue;  // nothing lit on the walk (the interval may still be beyond it)
+            ++withLight;
+            ASSERT_TRUE(any) << "cone " << cone << " ray " << i;
+            EXPECT_LE(t0, lo + 2e-3f) << "cone " << cone << " ray " << i;
+            EXPECT_GE(t1, hi - 2e-3f) << "cone " << cone << " ray " << i;
+            // Tight: the hull's ends are lit (or the ray's start, or beyond the walk).
+            if (t0 > 0) EXPECT_NEAR(t0, lo, 2e-3f) << "cone " << cone << " ray " << i;
+            if (t1 < 19.99f) EXPECT_NEAR(t1, hi, 2e-3f) << "cone " << cone << " ray " << i;
+        }
+    }
+    EXPECT_GT(withLight, 300);
+    // Other lights reach all of the ray.
+    Light point(pointLight(Vec3(0), Color(1)));
+    float t0, t1;
+    ASSERT_TRUE(point.reachInterval(Ray{Vec3(1, 0, 0), Vec3(0, 1, 0)}, t0, t1));
+    EXPECT_EQ(t0, 0.f);
+    EXPECT_TRUE(std::isinf(t1));
 }
 
 }  // namespace

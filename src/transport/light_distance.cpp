@@ -1,0 +1,109 @@
+#include "transport/light_distance.h"
+
+#include <cmath>
+
+#include "transport/direct_light.h"
+#include "transport/path_tracer.h"
+#include "transport/tracking.h"
+#include "transport/transmittance.h"
+
+namespace vdbmarch {
+
+namespace {
+
+// The density with which delta tracking makes a scattering collision at t,
+// for the weights only: sigma_s of the tracked channel times the
+// transmittance of the region's constant media (gridded media count as
+// clear: see the header).
+float trackingDensity(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp) {
+    float tau = 0;
+    for (int mi : ctx.scene.regions[size_t(seg.region)].media) {
+        float integral;
+        if (!ctx.queries[size_t(mi)]->densityIntegral(seg.ray, 0.f, t, integral) || !(integral > 0)) continue;
+        const Medium& m = *ctx.scene.media[size_t(mi)];
+        tau += trackedSigmaT(m.sigma_a + m.sigma_s, seg.channel) * integral;
+    }
+    return trackedOrAverage(mp.sigma_s, seg.channel) * std::exp(-tau);
+}
+
+// The power heuristic between the equiangular density and the tracking one.
+float equiangularWeight(const LightDistanceSegment& seg, float pdfEquiangular, float pdfTracking) {
+    if (!(pdfEquiangular > 0)) return 0.f;
+    if (seg.equiangularOnly) return 1.f;
+    const double a = double(pdfEquiangular) * pdfEquiangular, b = double(pdfTracking) * pdfTracking;
+    return float(a / (a + b));
+}
+
+}  // namespace
+
+LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
+                                           bool skipPointLights) {
+    ctx.lightDistances.clear();
+    const Scene& scene = ctx.scene;
+    const VolumeSampling mode = scene.desc.render.volumeSampling;
+    LightDistanceSegment seg{ray, region, channel, mode == VolumeSampling::Equiangular};
+    if (mode == VolumeSampling::Distance) return seg;
+    // The hull of the scattering media's bounds along the segment.
+    float a = Infinity, b = -Infinity;
+    for (int mi : scene.regions[size_t(region)].media) {
+        const Medium& m = *scene.media[size_t(mi)];
+        if (isBlack(m.sigma_s) || m.isVacuum()) continue;
+        float t0 = 0, t1 = tEnd;
+        if (!m.worldBounds().intersect(ray, t0, t1)) continue;
+        a = std::min(a, t0);
+        b = std::max(b, t1);
+    }
+    if (!(b > a)) return seg;
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        const Light& light = scene.lights[i];
+        if (!(light.isPointLike() || light.isSphere()) || (skipPointLights && light.isPointLike())) continue;
+        if (ctx.blockingSurfaces && ctx.lightRegions[i] != region) continue;
+        float t0, t1;
+        if (!light.reachInterval(ray, t0, t1)) continue;
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+        if (!(t1 > t0)) continue;
+        // A ray through a point light's very position: keep the density finite.
+        const float minDistance = light.isSphere() ? light.desc().radius : 1e-6f * scene.sceneScale;
+        EquiangularSampler s(ray.o, ray.d, light.desc().position, t0, t1, minDistance);
+        if (s.valid()) ctx.lightDistances.push_back({int(i), s});
+    }
+    seg.active = !ctx.lightDistances.empty();
+    return seg;
+}
+
+Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng) {
+    Color L(0);
+    MediumPoint mp;
+    for (const ThreadContext::LightDistance& ld : ctx.lightDistances) {
+        const float u = rng.uniform();
+        const float t = ld.sampler.sample(u);
+        const float pdf = ld.sampler.pdf(t);
+        if (!(pdf > 0)) continue;
+        const Vec3 x = seg.ray.at(t);
+        evalMedia(ctx, seg.region, x, mp);
+        if (!mp.scatters()) continue;
+        const float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
+        if (!(w > 0)) continue;
+        const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng);
+        if (isBlack(T)) continue;
+        DirectLightOptions o;
+        o.transmittance = TransmittanceEstimator::RatioTracking;
+        o.misWithPathHits = true;  // a sphere light is also found by the phase-sampled path
+        o.sampleBackground = false;
+        o.onlyLight = ld.light;
+        const Color nee = directLight(ctx, seg.region, ScatterVertex::inMedium(x, seg.ray.d, mp.phase), rng, o);
+        L += T * mp.sigma_s * nee * (w / pdf);
+    }
+    return L;
+}
+
+const float* trackingWeights(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp) {
+    ctx.lightWeights.assign(ctx.scene.lights.size(), 1.f);
+    const float pTrack = trackingDensity(ctx, seg, t, mp);
+    for (const ThreadContext::LightDistance& ld : ctx.lightDistances)
+        ctx.lightWeights[size_t(ld.light)] = 1 - equiangularWeight(seg, ld.sampler.pdf(t), pTrack);
+    return ctx.lightWeights.data();
+}
+
+}  // namespace vdbmarch

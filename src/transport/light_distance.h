@@ -1,0 +1,55 @@
+// Distance sampling towards lights (equiangular sampling, Kulla & Fajardo
+// 2012), combined with the free flights of delta tracking by multiple
+// importance sampling. Near a point, spot or sphere light the light that
+// scatters grows as 1/r^2, and a free flight drawn by transmittance alone
+// seldom lands there: in a thin haze a spot's narrow beam holds a few
+// collisions in a hundred, and a collision close to a light inside a medium
+// brings a 1/d^2 firefly. So every path segment in a scattering region also
+// draws, for each such light, one point by the equiangular density over the
+// part of the segment the light reaches (a spot's cone, the scattering
+// media's bounds), and estimates that light's single scattering there; the
+// next-event estimate of the same light at a tracking collision takes the
+// complementary weight.
+//
+// The two strategies' power-heuristic weights sum to one at every t, so the
+// sum is unbiased whatever densities the weights are computed from. The
+// tracking density in them is sigma_s(t) T(t) with T exact in constant media
+// and taken as 1 in gridded ones: an estimate of T is random, and a weight
+// must be a function of t alone. At the sample, T itself comes from ratio
+// tracking (unbiased).
+#pragma once
+
+#include "core/rng.h"
+#include "transport/media_point.h"
+
+namespace vdbmarch {
+
+// One path segment [0, tEnd) of `ray` in `region`, with the equiangular
+// samplers of its lights (kept in ctx.lightDistances).
+struct LightDistanceSegment {
+    Ray ray;
+    int region;
+    int channel;  // tracked channel, < 0 for grey extinction
+    // render.volume_sampling = "equiangular": the distance samples take all
+    // of a light's single scattering where they can land (no MIS).
+    bool equiangularOnly = false;
+    bool any() const { return active; }
+    bool active = false;
+};
+
+// Sets up the samplers of the segment: one per point-like or sphere light
+// that reaches a scattering part of it (point-like lights left out when
+// `skipPointLights`, as next-event estimation leaves them).
+LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
+                                           bool skipPointLights);
+
+// One distance sample per prepared light: T(t) sigma_s(t) f L T_shadow w / pdf(t),
+// the light's single scattering along the segment weighted for MIS.
+Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng);
+
+// Per scene light, the weight of next-event estimation at a tracking
+// collision at t (media mp there): 1 for lights without a sampler. Written to
+// ctx.lightWeights; returns its data for DirectLightOptions::lightWeights.
+const float* trackingWeights(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp);
+
+}  // namespace vdbmarch
