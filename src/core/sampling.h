@@ -88,6 +88,18 @@ public:
         const double t = mDelta + mD * std::tan(mThetaA + double(u) * (mThetaB - mThetaA));
         return clamp(float(t), mA, mB);
     }
+    // The ratio of the largest to the smallest 1/r^2 over [a, b] (infinite
+    // for an unbounded interval): near 1, the density is nearly uniform.
+    float falloffRange() const {
+        return falloffRange(mDelta, mD, mA, mB);
+    }
+    // The same without the sampler's angles (two atan2): for a caller that
+    // decides whether to sample at all.
+    static float falloffRange(const Vec3& o, const Vec3& d, const Vec3& c, float a, float b, float minDistance) {
+        const Vec3 oc = c - o;
+        const double delta = double(dot(oc, d));
+        return falloffRange(delta, std::max(double(length(oc - d * float(delta))), double(minDistance)), a, b);
+    }
     // Density of sample() at t; 0 outside [a, b].
     float pdf(float t) const {
         if (!mValid || !(t >= mA && t <= mB)) return 0.f;
@@ -96,6 +108,12 @@ public:
     }
 
 private:
+    static float falloffRange(double delta, double D, float a, float b) {
+        const double xa = std::fabs(double(a) - delta), xb = std::fabs(double(b) - delta);
+        const double xMin = double(a) <= delta && delta <= double(b) ? 0.0 : std::min(xa, xb);
+        const double xMax = std::max(xa, xb);
+        return float((D * D + xMax * xMax) / (D * D + xMin * xMin));
+    }
     double mDelta = 0, mD = 1, mThetaA = 0, mThetaB = 0;
     float mA = 0, mB = 0;
     bool mValid = false;

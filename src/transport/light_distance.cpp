@@ -43,6 +43,13 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     const VolumeSampling mode = scene.desc.render.volumeSampling;
     LightDistanceSegment seg{ray, region, channel, mode == VolumeSampling::Equiangular};
     if (mode == VolumeSampling::Distance) return seg;
+    bool candidate = false;
+    for (size_t i = 0; i < scene.lights.size() && !candidate; ++i) {
+        const Light& light = scene.lights[i];
+        candidate = (light.isSphere() || (light.isPointLike() && !skipPointLights)) &&
+                    !(ctx.blockingSurfaces && ctx.lightRegions[i] != region);
+    }
+    if (!candidate) return seg;
     // The hull of the scattering media's bounds along the segment.
     float a = Infinity, b = -Infinity;
     for (int mi : scene.regions[size_t(region)].media) {
@@ -65,7 +72,21 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
         if (!(t1 > t0)) continue;
         // A ray through a point light's very position: keep the density finite.
         const float minDistance = light.isSphere() ? light.desc().radius : 1e-6f * scene.sceneScale;
-        EquiangularSampler s(ray.o, ray.d, light.desc().position, t0, t1, minDistance);
+        // Worth its shadow ray only where the light's 1/r^2 varies along the
+        // part it reaches (a light near the segment) or where that part is a
+        // small piece of the medium's span (a spot's beam): elsewhere delta
+        // tracking spreads its collisions as evenly as the light does (a
+        // light far above a fog layer). A function of the segment alone, so
+        // the tracking weight is 1 wherever this skips: still unbiased.
+        // A sphere light's radiance is bounded (its solid angle, not 1/r^2,
+        // grows near it) and next-event estimation already meets the path's
+        // hits by MIS there: it needs a much steeper falloff to pay (measured
+        // on exp1_sphere and fig4_caustic_sphere, BENCHMARKS.md).
+        const Vec3& c = light.desc().position;
+        const float steepness = light.isSphere() ? 64.f : 4.f;
+        const bool steep = EquiangularSampler::falloffRange(ray.o, ray.d, c, t0, t1, minDistance) > steepness;
+        if (!steep && !(t1 - t0 < 0.5f * (b - a))) continue;
+        EquiangularSampler s(ray.o, ray.d, c, t0, t1, minDistance);
         if (s.valid()) ctx.lightDistances.push_back({int(i), s});
     }
     seg.active = !ctx.lightDistances.empty();

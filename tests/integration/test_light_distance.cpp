@@ -32,7 +32,7 @@ TEST(LightDistance, SingleScatteringFromPointAndSpotMatchesQuadrature) {
     const double sigmaT = 1.0, sigmaS = 0.8;
     const float g = 0.5f;
     const std::string lights = R"("lights": [
-        {"type": "point", "position": [1.075, 0.475, 0.1], "intensity": 0.5},
+        {"type": "point", "position": [0.85, 0.475, 0.1], "intensity": 0.5},
         {"type": "spot", "position": [0.475, -0.3, -0.2], "direction": [0, 1, 0.15], "cone_deg": 10,
          "falloff_deg": 3, "intensity": 2}])";
     const std::string media = str(R"("media": [{"type": "homogeneous", "sigma_a": 0.2, "sigma_s": 0.8, "g": )", g,
@@ -41,7 +41,7 @@ TEST(LightDistance, SingleScatteringFromPointAndSpotMatchesQuadrature) {
         "look_at": [0.475, 0.475, 0], "up": [0, 1, 0], "width_world": 0.5, "resolution": [32, 32]})";
 
     // Quadrature of the view-square mean, whole and by halves in x.
-    const Light point(pointLight(Vec3(1.075f, 0.475f, 0.1f), Color(0.5f)));
+    const Light point(pointLight(Vec3(0.85f, 0.475f, 0.1f), Color(0.5f)));
     const Light spot(spotLight(Vec3(0.475f, -0.3f, -0.2f), normalize(Vec3(0, 1, 0.15f)), 10, 3, Color(2)));
     const Vec3 d(0, 0, -1);
     const int nxy = 160, nz = 800;
