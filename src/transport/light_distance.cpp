@@ -74,18 +74,19 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
         const float minDistance = light.isSphere() ? light.desc().radius : 1e-6f * scene.sceneScale;
         // Worth its shadow ray only where the light's 1/r^2 varies along the
         // part it reaches (a light near the segment) or where that part is a
-        // small piece of the medium's span (a spot's beam): elsewhere delta
+        // piece of the medium's span (a spot's beam): elsewhere delta
         // tracking spreads its collisions as evenly as the light does (a
         // light far above a fog layer). A function of the segment alone, so
         // the tracking weight is 1 wherever this skips: still unbiased.
         // A sphere light's radiance is bounded (its solid angle, not 1/r^2,
         // grows near it) and next-event estimation already meets the path's
-        // hits by MIS there: it needs a much steeper falloff to pay (measured
+        // hits by MIS there: it needs a much larger gain to pay (measured
         // on exp1_sphere and fig4_caustic_sphere, BENCHMARKS.md).
         const Vec3& c = light.desc().position;
-        const float steepness = light.isSphere() ? 64.f : 4.f;
-        const bool steep = EquiangularSampler::falloffRange(ray.o, ray.d, c, t0, t1, minDistance) > steepness;
-        if (!steep && !(t1 - t0 < 0.5f * (b - a))) continue;
+        // The gain over tracking: how much the light's falloff varies along
+        // its reach, times how much of the medium's span it leaves out.
+        const float gain = EquiangularSampler::falloffRange(ray.o, ray.d, c, t0, t1, minDistance) * ((b - a) / (t1 - t0));
+        if (!(gain > (light.isSphere() ? 64.f : 2.f))) continue;
         EquiangularSampler s(ray.o, ray.d, c, t0, t1, minDistance);
         if (s.valid()) ctx.lightDistances.push_back({int(i), s});
     }
