@@ -85,7 +85,9 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
         const Vec3& c = light.desc().position;
         // The gain over tracking: how much the light's falloff varies along
         // its reach, times how much of the medium's span it leaves out.
-        const float gain = EquiangularSampler::falloffRange(ray.o, ray.d, c, t0, t1, minDistance) * ((b - a) / (t1 - t0));
+        // (Unbounded fog and an escaping ray: both spans infinite, nothing left out.)
+        const float span = b - a, reach = t1 - t0, leftOut = span == reach ? 1.f : span / reach;
+        const float gain = EquiangularSampler::falloffRange(ray.o, ray.d, c, t0, t1, minDistance) * leftOut;
         if (!(gain > (light.isSphere() ? 64.f : 2.f))) continue;
         EquiangularSampler s(ray.o, ray.d, c, t0, t1, minDistance);
         if (s.valid()) ctx.lightDistances.push_back({int(i), s});
