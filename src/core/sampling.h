@@ -90,11 +90,8 @@ public:
     }
     // The ratio of the largest to the smallest 1/r^2 over [a, b] (infinite
     // for an unbounded interval): near 1, the density is nearly uniform.
-    float falloffRange() const {
-        return falloffRange(mDelta, mD, mA, mB);
-    }
-    // The same without the sampler's angles (two atan2): for a caller that
-    // decides whether to sample at all.
+    // Without a sampler (no atan2): for a caller that decides whether to
+    // sample at all.
     static float falloffRange(const Vec3& o, const Vec3& d, const Vec3& c, float a, float b, float minDistance) {
         const Vec3 oc = c - o;
         const double delta = double(dot(oc, d));

@@ -43,13 +43,15 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     const VolumeSampling mode = scene.desc.render.volumeSampling;
     LightDistanceSegment seg{ray, region, channel, mode == VolumeSampling::Equiangular};
     if (mode == VolumeSampling::Distance) return seg;
-    bool candidate = false;
-    for (size_t i = 0; i < scene.lights.size() && !candidate; ++i) {
+    // Point-like and sphere lights that shadow rays from this region can see.
+    auto eligible = [&](size_t i) {
         const Light& light = scene.lights[i];
-        candidate = (light.isSphere() || (light.isPointLike() && !skipPointLights)) &&
-                    !(ctx.blockingSurfaces && ctx.lightRegions[i] != region);
-    }
-    if (!candidate) return seg;
+        return (light.isSphere() || (light.isPointLike() && !skipPointLights)) &&
+               !(ctx.blockingSurfaces && ctx.lightRegions[i] != region);
+    };
+    bool any = false;
+    for (size_t i = 0; i < scene.lights.size() && !any; ++i) any = eligible(i);
+    if (!any) return seg;
     // The hull of the scattering media's bounds along the segment.
     float a = Infinity, b = -Infinity;
     for (int mi : scene.regions[size_t(region)].media) {
@@ -62,9 +64,8 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     }
     if (!(b > a)) return seg;
     for (size_t i = 0; i < scene.lights.size(); ++i) {
+        if (!eligible(i)) continue;
         const Light& light = scene.lights[i];
-        if (!(light.isPointLike() || light.isSphere()) || (skipPointLights && light.isPointLike())) continue;
-        if (ctx.blockingSurfaces && ctx.lightRegions[i] != region) continue;
         float t0, t1;
         if (!light.reachInterval(ray, t0, t1)) continue;
         t0 = std::max(t0, a);

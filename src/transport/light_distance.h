@@ -33,8 +33,7 @@ struct LightDistanceSegment {
     // render.volume_sampling = "equiangular": the distance samples take all
     // of a light's single scattering where they can land (no MIS).
     bool equiangularOnly = false;
-    bool any() const { return active; }
-    bool active = false;
+    bool active = false;  // some light has a sampler
 };
 
 // Sets up the samplers of the segment: one per point-like or sphere light

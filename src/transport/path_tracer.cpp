@@ -63,7 +63,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         const LightDistanceSegment lightDistances =
             st.depth < maxDepth ? prepareLightDistances(ctx, region, ray, tEnd, channel, st.pointLightsByPhotons)
                                 : LightDistanceSegment{};
-        if (lightDistances.any()) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
+        if (lightDistances.active) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
 
         // Delta tracking to the next real collision, or to tEnd; the
         // collision callback returns false once the path scattered or was absorbed.
@@ -87,7 +87,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 return false;
             }
             const float* weights =
-                lightDistances.any() ? trackingWeights(ctx, lightDistances, dot(x - ray.o, ray.d), mp) : nullptr;
+                lightDistances.active ? trackingWeights(ctx, lightDistances, dot(x - ray.o, ray.d), mp) : nullptr;
             add(beta * directLight(ctx, region, ScatterVertex::inMedium(x, ray.d, mp.phase), rng,
                                    nextEventOptions(st, weights)),
                 st.depth);

@@ -93,8 +93,12 @@ TEST(SpotLight, ReachIntervalHoldsEveryLitPointOfTheRay) {
             EXPECT_LE(t0, lo + 2e-3f) << "cone " << cone << " ray " << i;
             EXPECT_GE(t1, hi - 2e-3f) << "cone " << cone << " ray " << i;
             // Tight: the hull's ends are lit (or the ray's start, or beyond the walk).
-            if (t0 > 0) EXPECT_NEAR(t0, lo, 2e-3f) << "cone " << cone << " ray " << i;
-            if (t1 < 19.99f) EXPECT_NEAR(t1, hi, 2e-3f) << "cone " << cone << " ray " << i;
+            if (t0 > 0) {
+                EXPECT_NEAR(t0, lo, 2e-3f) << "cone " << cone << " ray " << i;
+            }
+            if (t1 < 19.99f) {
+                EXPECT_NEAR(t1, hi, 2e-3f) << "cone " << cone << " ray " << i;
+            }
         }
     }
     EXPECT_GT(withLight, 300);
