@@ -49,7 +49,7 @@ Color opticalDepth(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng
 
 // Ratio tracking through the region's media over [0, tEnd): constant media
 // exactly, gridded media against their local majorants (the maximum over
-// channels, so the weights stay in [0, 1]).
+// channels, so the weights stay in [0, 1]), residual to each block's minimum.
 Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng) {
     Color T(1);
     for (int mi : ctx.scene.regions[size_t(region)].media) {
@@ -68,7 +68,21 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
         // cloud never visits the blocks behind.
         bool ended = false;
         forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& seg) {
-            const float sigmaMaj = mediumMajorant(seg.maxDensity, kMax);
+            // Residual ratio tracking (Novak et al. 2014): the segment's
+            // density lower bound is a control whose transmittance is exact,
+            // exp(-k rho_min len); tentative collisions only track the
+            // residual rho - rho_min, at rate k_max (rho_max - rho_min), with
+            // weights 1 - k (rho - rho_min) / sigma_r in [0, 1]. Where the
+            // block's density varies little, few collisions and little noise.
+            const float lo = std::min(seg.minDensity, seg.maxDensity);
+            if (lo > 0 && seg.t1 > seg.t0)
+                for (int c = 0; c < 3; ++c)
+                    if (k[c] > 0) T[c] *= std::exp(-double(k[c]) * lo * (double(seg.t1) - seg.t0));
+            if (lo > 0 && isBlack(T)) {
+                ended = true;
+                return false;
+            }
+            const float sigmaMaj = mediumMajorant(seg.maxDensity - lo, kMax);
             if (!(sigmaMaj > 0)) return true;
             // The step floor of deltaTrack (tracking.h) for absurd majorants.
             const bool absurd = double(sigmaMaj) * double(ctx.scene.step) > 1e6;
@@ -80,7 +94,7 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
                 if (t >= seg.t1) return true;
                 ++ctx.counters.shadowSamples;
                 const float d = q.density(r.at(t));
-                for (int c = 0; c < 3; ++c) T[c] *= std::max(0.f, 1 - k[c] * d / sigmaMaj);
+                for (int c = 0; c < 3; ++c) T[c] *= std::max(0.f, 1 - k[c] * (d - lo) / sigmaMaj);
                 if (!russianRoulette(T, rng)) {
                     ended = true;
                     return false;

@@ -22,7 +22,7 @@ public:
     void forEachMajorant(const Ray& r, float tMin, float tMax,
                          const std::function<bool(const MajorantSegment&)>& visit) override {
         float t0 = tMin, t1 = tMax;
-        if (!mBounded || (mBounds.intersect(r, t0, t1) && t1 > t0)) visit({t0, t1, 1.f});
+        if (!mBounded || (mBounds.intersect(r, t0, t1) && t1 > t0)) visit({t0, t1, 1.f, 1.f});
     }
     bool densityIntegral(const Ray& r, float tMin, float tMax, float& integral) override {
         integral = 0;

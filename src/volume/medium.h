@@ -16,9 +16,11 @@
 namespace vdbmarch {
 
 // A piece of a ray with an upper bound on the density over it (a local
-// majorant from the VDB tree, for delta and ratio tracking).
+// majorant from the VDB tree, for delta and ratio tracking) and a lower bound
+// (the control of residual ratio tracking; 0 where none is known).
 struct MajorantSegment {
     float t0, t1, maxDensity;
+    float minDensity = 0;
 };
 
 class MediumQuery {

@@ -241,6 +241,9 @@ struct PaddedBlocks {
     // non-zero value: lo in bits 0-11, hi (exclusive, 1..8) in bits 12-23.
     std::vector<uint32_t> tightBox;
     std::vector<float> blockMax;  // largest value in each padded block: a local majorant
+    // Smallest value in each padded block: every trilinear value inside the
+    // block's cells is a convex combination of them, so at least this.
+    std::vector<float> blockMin;
 
     static uint32_t computeTightBox(const float* v) {
         int lo[3] = {8, 8, 8}, hi[3] = {0, 0, 0};
@@ -278,7 +281,7 @@ struct PaddedBlocks {
         values.assign(origins.size() * Size, 0.f);
         std::vector<char> nonEmpty(origins.size(), 0);
         std::vector<uint32_t> boxes(origins.size(), 0);
-        std::vector<float> maxima(origins.size(), 0.f);
+        std::vector<float> maxima(origins.size(), 0.f), minima(origins.size(), 0.f);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
             auto acc = grid.getConstAccessor();
             for (size_t b = r.begin(); b != r.end(); ++b) {
@@ -294,7 +297,9 @@ struct PaddedBlocks {
                         }
                 nonEmpty[b] = any;
                 if (any) boxes[b] = computeTightBox(dst);
-                maxima[b] = *std::max_element(dst, dst + Size);
+                const auto range = std::minmax_element(dst, dst + Size);
+                minima[b] = std::max(0.f, *range.first);
+                maxima[b] = *range.second;
             }
         });
         // Compact: drop all-zero blocks.
@@ -305,6 +310,7 @@ struct PaddedBlocks {
             index.setValue(origins[b], int32_t(kept + 1));
             tightBox.push_back(boxes[b]);
             blockMax.push_back(maxima[b]);
+            blockMin.push_back(minima[b]);
             ++kept;
         }
         values.resize(kept * Size);
@@ -643,14 +649,15 @@ void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector
 void VdbQuery::forEachMajorant(const Ray& r, float tMin, float tMax,
                                const std::function<bool(const MajorantSegment&)>& visit) {
     const auto& maxima = mMedium.mBlocks.blockMax;
+    const auto& minima = mMedium.mBlocks.blockMin;
     const float scale = mMedium.mScale;
-    // Adjacent blocks with the same maximum are merged before visiting.
+    // Adjacent blocks with the same bounds are merged before visiting.
     MajorantSegment pending{0, 0, -1};
     bool stopped = false;
     walkBlocks(r, tMin, tMax, [&](double a, double b, size_t block) {
-        float fa = float(a), fb = float(b), m = maxima[block] * scale;
+        float fa = float(a), fb = float(b), m = maxima[block] * scale, lo = minima[block] * scale;
         if (!(fb > fa)) return true;
-        if (pending.maxDensity == m && fa <= pending.t1) {
+        if (pending.maxDensity == m && pending.minDensity == lo && fa <= pending.t1) {
             pending.t1 = std::max(pending.t1, fb);
             return true;
         }
@@ -658,7 +665,7 @@ void VdbQuery::forEachMajorant(const Ray& r, float tMin, float tMax,
             stopped = true;
             return false;
         }
-        pending = {fa, fb, m};
+        pending = {fa, fb, m, lo};
         return true;
     });
     if (!stopped && pending.maxDensity >= 0) visit(pending);
