@@ -40,7 +40,7 @@ enum class TransmittanceEstimator {
     // exp(-tau) with tau integrated in uniform steps of render.shadow_step
     // from a random offset (the marchers: cheap, consistent as steps shrink).
     Stepped,
-    // Ratio tracking against local majorants (the reference: unbiased).
+    // Residual ratio tracking against local density bounds (the reference: unbiased).
     RatioTracking,
 };
 
