@@ -38,8 +38,8 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         const Light& light = scene.lights[i];
         if (o.onlyLight >= 0 && int(i) != o.onlyLight) continue;
         if (o.skipPointLights && light.isPointLike()) continue;
-        const float lightWeight = o.lightWeights ? o.lightWeights[i] : 1.f;
-        if (!(lightWeight > 0)) continue;
+        float lightWeight = o.lightWeights ? o.lightWeights[i] : 1.f;
+        if (!(lightWeight > 0) || !rouletteOnWeight(lightWeight, rng)) continue;
         LightSample ls;
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;

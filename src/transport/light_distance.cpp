@@ -108,8 +108,8 @@ Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, 
         const Vec3 x = seg.ray.at(t);
         evalMedia(ctx, seg.region, x, mp);
         if (!mp.scatters()) continue;
-        const float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
-        if (!(w > 0)) continue;
+        float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
+        if (!(w > 0) || !rouletteOnWeight(w, rng)) continue;
         const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng);
         if (isBlack(T)) continue;
         DirectLightOptions o;
