@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/sampling.h"
+#include "transport/roulette.h"
 
 namespace vdbmarch {
 
@@ -39,7 +40,7 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         if (o.onlyLight >= 0 && int(i) != o.onlyLight) continue;
         if (o.skipPointLights && light.isPointLike()) continue;
         float lightWeight = o.lightWeights ? o.lightWeights[i] : 1.f;
-        if (!(lightWeight > 0) || !rouletteOnWeight(lightWeight, rng)) continue;
+        if (!(lightWeight > 0) || !russianRoulette(lightWeight, rng, MisWeightRouletteThreshold)) continue;
         LightSample ls;
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;

@@ -60,18 +60,6 @@ struct DirectLightOptions {
 
 Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng, const DirectLightOptions& options);
 
-// A sample whose MIS weight w is small is worth little of its shadow ray:
-// below MinTracedWeight it goes on with probability w / MinTracedWeight and
-// then counts MinTracedWeight (Russian roulette: the expectation is w).
-// Returns false when the sample is dropped; updates w.
-constexpr float MinTracedWeight = 0.25f;
-inline bool rouletteOnWeight(float& w, Rng& rng) {
-    if (w >= MinTracedWeight) return true;
-    if (rng.uniform() * MinTracedWeight >= w) return false;
-    w = MinTracedWeight;
-    return true;
-}
-
 inline float powerHeuristic(float a, float b) {
     const float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.f;

@@ -4,6 +4,8 @@
 
 #include "transport/direct_light.h"
 #include "transport/path_tracer.h"
+#include "transport/roulette.h"
+#include "transport/surface_event.h"
 #include "transport/tracking.h"
 #include "transport/transmittance.h"
 
@@ -15,6 +17,18 @@ namespace {
 // for the weights only: sigma_s of the tracked channel times the
 // transmittance of the region's constant media (gridded media count as
 // clear: see the header).
+// A ray through a point light's very position: keep the density finite.
+float minDistance(const Scene& scene, const Light& light) {
+    return light.isSphere() ? light.desc().radius : 1e-6f * scene.sceneScale;
+}
+
+// Distance sampling pays where its gain over tracking exceeds this (see
+// prepareLightDistances). A sphere light's radiance is bounded (its solid
+// angle, not 1/r^2, grows near it) and next-event estimation already meets
+// the path's hits by MIS there: it needs a much larger gain (measured on
+// exp1_sphere and fig4_caustic_sphere, BENCHMARKS.md).
+float gainThreshold(const Light& light) { return light.isSphere() ? 64.f : 2.f; }
+
 float trackingDensity(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp) {
     float tau = 0;
     for (int mi : ctx.scene.regions[size_t(seg.region)].media) {
@@ -34,6 +48,43 @@ float equiangularWeight(const LightDistanceSegment& seg, float pdfEquiangular, f
     return float(a / (a + b));
 }
 
+// Per region the hull of its scattering media's bounds, and per (region,
+// light) whether distance sampling can ever pay there: the light is
+// point-like or a sphere; no surface that blocks shadow rays separates it
+// from the region; and, for point and sphere lights (whose reach is the
+// whole ray), the falloff range over the region's bounds, at most
+// (farthest corner / nearest point)^2, can exceed the gain threshold.
+void buildCandidates(ThreadContext& ctx) {
+    const Scene& scene = ctx.scene;
+    bool blocking = false;
+    for (const SurfaceInfo& surface : scene.surfaces) blocking |= !crossedByShadowRays(surface.material);
+    const size_t nLights = scene.lights.size();
+    ctx.scatterBounds.assign(scene.regions.size(), BBox{});
+    ctx.lightDistanceCandidate.assign(scene.regions.size() * nLights, 0);
+    for (size_t r = 0; r < scene.regions.size(); ++r) {
+        BBox& hull = ctx.scatterBounds[r];
+        for (int mi : scene.regions[r].media) {
+            const Medium& m = *scene.media[size_t(mi)];
+            if (!isBlack(m.sigma_s) && !m.isVacuum()) hull.expand(m.worldBounds());
+        }
+        if (hull.empty()) continue;
+        for (size_t i = 0; i < nLights; ++i) {
+            const Light& light = scene.lights[i];
+            if (!(light.isPointLike() || light.isSphere())) continue;
+            const Vec3& c = light.desc().position;
+            if (blocking && regionAtRayStart(scene, Ray{c, Vec3(0, 0, 1)}) != int(r)) continue;
+            bool mayPay = true;
+            if (light.desc().type != LightDesc::Type::Spot && hull.isFinite()) {
+                const Vec3 nearest = min(max(c, hull.lo), hull.hi);
+                const Vec3 farthest = max(max(c - hull.lo, hull.lo - c), max(c - hull.hi, hull.hi - c));
+                const float rMin = std::max(length(c - nearest), minDistance(scene, light));
+                mayPay = lengthSquared(farthest) > gainThreshold(light) * rMin * rMin;
+            }
+            ctx.lightDistanceCandidate[r * nLights + i] = mayPay;
+        }
+    }
+}
+
 }  // namespace
 
 LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
@@ -42,28 +93,18 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     const Scene& scene = ctx.scene;
     const VolumeSampling mode = scene.desc.render.volumeSampling;
     LightDistanceSegment seg{ray, region, channel, mode == VolumeSampling::Equiangular};
-    if (mode == VolumeSampling::Distance) return seg;
-    // Point-like and sphere lights that shadow rays from this region can see.
-    auto eligible = [&](size_t i) {
-        const Light& light = scene.lights[i];
-        return (light.isSphere() || (light.isPointLike() && !skipPointLights)) &&
-               !(ctx.blockingSurfaces && ctx.lightRegions[i] != region);
-    };
+    if (mode == VolumeSampling::Distance || scene.lights.empty()) return seg;
+    if (ctx.lightDistanceCandidate.empty()) buildCandidates(ctx);
+    const size_t nLights = scene.lights.size();
+    const char* candidate = ctx.lightDistanceCandidate.data() + size_t(region) * nLights;
+    auto eligible = [&](size_t i) { return candidate[i] && !(skipPointLights && scene.lights[i].isPointLike()); };
     bool any = false;
-    for (size_t i = 0; i < scene.lights.size() && !any; ++i) any = eligible(i);
+    for (size_t i = 0; i < nLights && !any; ++i) any = eligible(i);
     if (!any) return seg;
-    // The hull of the scattering media's bounds along the segment.
-    float a = Infinity, b = -Infinity;
-    for (int mi : scene.regions[size_t(region)].media) {
-        const Medium& m = *scene.media[size_t(mi)];
-        if (isBlack(m.sigma_s) || m.isVacuum()) continue;
-        float t0 = 0, t1 = tEnd;
-        if (!m.worldBounds().intersect(ray, t0, t1)) continue;
-        a = std::min(a, t0);
-        b = std::max(b, t1);
-    }
-    if (!(b > a)) return seg;
-    for (size_t i = 0; i < scene.lights.size(); ++i) {
+    // The segment's part in the region's scattering media.
+    float a = 0, b = tEnd;
+    if (!ctx.scatterBounds[size_t(region)].intersect(ray, a, b) || !(b > a)) return seg;
+    for (size_t i = 0; i < nLights; ++i) {
         if (!eligible(i)) continue;
         const Light& light = scene.lights[i];
         float t0, t1;
@@ -71,26 +112,21 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
         t0 = std::max(t0, a);
         t1 = std::min(t1, b);
         if (!(t1 > t0)) continue;
-        // A ray through a point light's very position: keep the density finite.
-        const float minDistance = light.isSphere() ? light.desc().radius : 1e-6f * scene.sceneScale;
         // Worth its shadow ray only where the light's 1/r^2 varies along the
         // part it reaches (a light near the segment) or where that part is a
         // piece of the medium's span (a spot's beam): elsewhere delta
         // tracking spreads its collisions as evenly as the light does (a
-        // light far above a fog layer). A function of the segment alone, so
-        // the tracking weight is 1 wherever this skips: still unbiased.
-        // A sphere light's radiance is bounded (its solid angle, not 1/r^2,
-        // grows near it) and next-event estimation already meets the path's
-        // hits by MIS there: it needs a much larger gain to pay (measured
-        // on exp1_sphere and fig4_caustic_sphere, BENCHMARKS.md).
+        // light far above a fog layer). The gain over tracking is the
+        // falloff range along the reach times the span it leaves out
+        // (unbounded fog and an escaping ray: both infinite, nothing left
+        // out). A function of the segment alone, so the tracking weight is 1
+        // wherever this skips: still unbiased.
         const Vec3& c = light.desc().position;
-        // The gain over tracking: how much the light's falloff varies along
-        // its reach, times how much of the medium's span it leaves out.
-        // (Unbounded fog and an escaping ray: both spans infinite, nothing left out.)
+        const float rMin = minDistance(scene, light);
         const float span = b - a, reach = t1 - t0, leftOut = span == reach ? 1.f : span / reach;
-        const float gain = EquiangularSampler::falloffRange(ray.o, ray.d, c, t0, t1, minDistance) * leftOut;
-        if (!(gain > (light.isSphere() ? 64.f : 2.f))) continue;
-        EquiangularSampler s(ray.o, ray.d, c, t0, t1, minDistance);
+        const float gain = EquiangularSampler::falloffRange(ray.o, ray.d, c, t0, t1, rMin) * leftOut;
+        if (!(gain > gainThreshold(light))) continue;
+        EquiangularSampler s(ray.o, ray.d, c, t0, t1, rMin);
         if (s.valid()) ctx.lightDistances.push_back({int(i), s});
     }
     seg.active = !ctx.lightDistances.empty();
@@ -109,7 +145,7 @@ Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, 
         evalMedia(ctx, seg.region, x, mp);
         if (!mp.scatters()) continue;
         float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
-        if (!(w > 0) || !rouletteOnWeight(w, rng)) continue;
+        if (!(w > 0) || !russianRoulette(w, rng, MisWeightRouletteThreshold)) continue;
         const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng);
         if (isBlack(T)) continue;
         DirectLightOptions o;

@@ -2,15 +2,10 @@
 
 #include <algorithm>
 
-#include "transport/surface_event.h"
-
 namespace vdbmarch {
 
 ThreadContext::ThreadContext(const Scene& s) : scene(s) {
     for (const auto& m : s.media) queries.push_back(m->makeQuery());
-    for (const SurfaceInfo& surface : s.surfaces) blockingSurfaces |= !crossedByShadowRays(surface.material);
-    for (const Light& l : s.lights)
-        lightRegions.push_back(l.isDelta() && !l.isPointLike() ? -1 : regionAtRayStart(s, Ray{l.desc().position, Vec3(0, 0, 1)}));
 }
 
 void evalMedia(ThreadContext& ctx, int region, const Vec3& p, MediumPoint& mp) {

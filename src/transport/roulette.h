@@ -36,4 +36,15 @@ inline bool russianRoulette(Color& beta, Rng& rng, float threshold = RouletteThr
     return true;
 }
 
+// The same rule for a scalar weight: a light sample whose MIS weight is
+// below MisWeightRouletteThreshold casts its shadow ray with probability
+// w / threshold and then counts the threshold (light_distance.h).
+constexpr float MisWeightRouletteThreshold = 0.25f;
+inline bool russianRoulette(float& w, Rng& rng, float threshold) {
+    Color c(w);
+    const bool on = russianRoulette(c, rng, threshold);
+    w = c.x;
+    return on;
+}
+
 }  // namespace vdbmarch

@@ -31,11 +31,11 @@ struct ThreadContext {
     };
     std::vector<LightDistance> lightDistances;
     std::vector<float> lightWeights;
-    // The region each light sits in, and whether some surface blocks shadow
-    // rays: a light in another region behind such a surface gets no
-    // distance samples (its shadow rays would mostly be blocked).
-    std::vector<int> lightRegions;
-    bool blockingSurfaces = false;
+    // Made on first use by light_distance.cpp: per region, the bounds of
+    // its scattering media, and per (region, light) whether the light can
+    // ever get distance samples there.
+    std::vector<BBox> scatterBounds;
+    std::vector<char> lightDistanceCandidate;
     RenderCounters counters;
     std::unique_ptr<ThreadContextExtension> extension;
 
