@@ -8,12 +8,14 @@
 # squared pair-RMSEs is the ratio of MSEs against the truth at equal time.
 # Usage: tools/bench_yardstick.sh YARDSTICK_BINARY OUT SCENE...
 # Environment: RES (default 160x120), BUDGETS (seconds, default "4 16"),
-# THREADS (default 2), NEW_SET and OLD_SET (extra --set options of each side,
+# THREADS (default 2), NEW_BIN (this build's binary, default build/bin/vdbmarch:
+# copy it aside to keep building while the benchmark runs), NEW_SET and
+# OLD_SET (extra --set options of each side,
 # default: render.method=reference on both).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OLD="$1"; OUT="$2"; shift 2
-NEW="$ROOT/build/bin/vdbmarch"
+NEW="${NEW_BIN:-$ROOT/build/bin/vdbmarch}"
 RES="${RES:-160x120}"; BUDGETS="${BUDGETS:-4 16}"; THREADS="${THREADS:-2}"
 NEW_SET="${NEW_SET:-render.method=reference}"; OLD_SET="${OLD_SET:-render.method=reference}"
 mkdir -p "$OUT"

@@ -18,7 +18,8 @@ double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 }  // namespace
 
 bool methodUsesCache(Method method, const RenderSettings& render) {
-    return method == Method::Guided || render.li == LiSource::Cache;
+    return method == Method::Guided || method == Method::GuidedPath ||
+           (render.li == LiSource::Cache && !isPathTracer(method));
 }
 
 void checkCacheMatchesScene(const RadianceCache& cache, const Scene& scene, const std::string& file, bool force) {
@@ -180,6 +181,12 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     rq.force = options.force;
     if (method == Method::Reference) {  // traces every path itself; render.li does not apply
         if (!options.cacheFile.empty()) warn(str(options.cacheFile, ": the reference tracer does not read a cache; ignored"));
+        return rq;
+    }
+    if (method == Method::GuidedPath) {  // the cache alone, as the paths' guide
+        rq.cache = true;
+        rq.cacheFile = options.cacheFile;
+        if (rs.productSampling) rq.cacheSettings.incidentOrder = 3;  // guided directions
         return rq;
     }
     rq.cache = methodUsesCache(method, rs);

@@ -16,6 +16,7 @@ const Entry kMarchers[] = {
     {Method::Transmittance, makeTransmittanceMarcher},
     {Method::Guided, makeGuidedMarcher},
     {Method::Reference, makeReferenceTracer},
+    {Method::GuidedPath, makeGuidedPathTracer},
 };
 }  // namespace
 

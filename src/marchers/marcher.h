@@ -44,5 +44,6 @@ std::unique_ptr<Marcher> makeUniformMarcher(const Scene& scene, std::shared_ptr<
 std::unique_ptr<Marcher> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
 std::unique_ptr<Marcher> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
 std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il);
+std::unique_ptr<Marcher> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il);
 
 }  // namespace vdbmarch

@@ -4,6 +4,12 @@
 // MIS for sphere lights, the shared surface event). Media whose extinction
 // differs between RGB channels are tracked one channel per path (three
 // paths per sample).
+//
+// Guided path tracing is the same loop with the radiance cache as its guide
+// (cache_path_guide.h): free flights, and with render.product_sampling
+// directions, drawn towards where the cache says the light is.
+#include "illumination/illumination.h"
+#include "marchers/cache_path_guide.h"
 #include "marchers/marcher.h"
 #include "transport/path_tracer.h"
 #include "transport/surface_event.h"
@@ -14,18 +20,23 @@ namespace {
 
 class ReferenceTracer final : public Marcher {
 public:
-    explicit ReferenceTracer(const Scene& s) : mScene(s), mChromatic(hasChromaticExtinction(s)) {}
+    ReferenceTracer(const Scene& s, std::shared_ptr<const Illumination> il = nullptr)
+        : mScene(s), mChromatic(hasChromaticExtinction(s)), mIllumination(std::move(il)) {
+        if (mIllumination && mIllumination->cache) mGuide = makeCachePathGuide(s, *mIllumination->cache);
+    }
 
     PathResult radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
         ++ctx.counters.cameraRays;
         const int region = regionAtRayStart(mScene, cameraRay);
+        PathState start;
+        start.guide = mGuide.get();
         if (!mChromatic) {
-            PathRadiance p = tracePath(ctx, cameraRay, region, -1, rng, {});
+            PathRadiance p = tracePath(ctx, cameraRay, region, -1, rng, start);
             return {p.L, p.transmittance, p.direct};
         }
         PathResult out{Color(0), 0.f};
         for (int c = 0; c < 3; ++c) {
-            PathRadiance p = tracePath(ctx, cameraRay, region, c, rng, {});
+            PathRadiance p = tracePath(ctx, cameraRay, region, c, rng, start);
             out.L[c] = p.L[c];
             out.direct[c] = p.direct[c];
             out.transmittance += p.transmittance / 3;
@@ -36,12 +47,18 @@ public:
 private:
     const Scene& mScene;
     const bool mChromatic;
+    std::shared_ptr<const Illumination> mIllumination;  // keeps the guide's cache alive
+    std::unique_ptr<PathGuide> mGuide;
 };
 
 }  // namespace
 
 std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination>) {
     return std::make_unique<ReferenceTracer>(scene);
+}
+
+std::unique_ptr<Marcher> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
+    return std::make_unique<ReferenceTracer>(scene, std::move(il));
 }
 
 }  // namespace vdbmarch

@@ -33,6 +33,15 @@ struct MarcherScratch final : ThreadContextExtension {
     // Continuation directions by phase x cached radiance (made on first use).
     std::unique_ptr<RadianceCache::Query> productQuery;
     ProductDirectionSampler productSampler;
+    // Guided path tracing's prepared free flight (cache_path_guide.h): the
+    // segment, its probability of a collision, and its bins in pdfSteps,
+    // stepH and rayPdf.
+    struct FlightState {
+        Ray ray;
+        int region = 0;
+        float tEnd = 0;
+        double scatter = 0;
+    } flight;
     // The guided marcher's pre-pass (eq. 17's scale): march without sampling
     // and sum each segment's throughput times its histogram integral.
     bool measureOnly = false;

@@ -12,6 +12,7 @@ const MethodName kMethods[] = {
     {Method::Transmittance, "transmittance"},
     {Method::Guided, "guided"},
     {Method::Reference, "reference"},
+    {Method::GuidedPath, "guided_path"},
 };
 }  // namespace
 

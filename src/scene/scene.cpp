@@ -46,7 +46,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
                      "\") has emission but sigma_a = 0: emission enters as sigma_a L_e, so it is invisible"));
         scene->media.push_back(std::move(m));
     }
-    if (desc.render.method == Method::Reference) {
+    if (isPathTracer(desc.render.method)) {
         bool deltaLight = false, glassWithMedium = false;
         for (const auto& l : desc.lights) deltaLight = deltaLight || l.type != LightDesc::Type::Sphere;
         for (const auto& s : desc.surfaces)

@@ -13,10 +13,6 @@ namespace vdbmarch {
 
 namespace {
 
-// The density with which delta tracking makes a scattering collision at t,
-// for the weights only: sigma_s of the tracked channel times the
-// transmittance of the region's constant media (gridded media count as
-// clear: see the header).
 // A ray through a point light's very position: keep the density finite.
 float minDistance(const Scene& scene, const Light& light) {
     return light.isSphere() ? light.desc().radius : 1e-6f * scene.sceneScale;
@@ -29,7 +25,12 @@ float minDistance(const Scene& scene, const Light& light) {
 // exp1_sphere and fig4_caustic_sphere, BENCHMARKS.md).
 float gainThreshold(const Light& light) { return light.isSphere() ? 64.f : 2.f; }
 
+// The density with which delta tracking makes a scattering collision at t,
+// for the weights only: sigma_s of the tracked channel times the
+// transmittance of the region's constant media (gridded media count as
+// clear: see the header), or the guided flight's own density.
 float trackingDensity(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp) {
+    if (seg.guide) return seg.guide->flightDensity(ctx, t);
     float tau = 0;
     for (int mi : ctx.scene.regions[size_t(seg.region)].media) {
         float integral;

@@ -4,6 +4,7 @@
 #include "transport/direct_light.h"
 #include "transport/light_distance.h"
 #include "transport/media_point.h"
+#include "transport/path_guide.h"
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
@@ -57,50 +58,79 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
         float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
 
+        // A guide may take this segment's free flight (path_guide.h); at
+        // max_depth a collision could only end the path, so it is tracked.
+        const bool guided =
+            st.guide && st.depth < maxDepth && st.guide->prepareFlight(ctx, region, ray, tEnd, channel);
+
         // Distance sampling towards point, spot and sphere lights along the
-        // segment, weighed against the tracking collisions' next-event
-        // estimates by MIS (light_distance.h).
-        const LightDistanceSegment lightDistances =
+        // segment, weighed against the collisions' next-event estimates by
+        // MIS (light_distance.h).
+        LightDistanceSegment lightDistances =
             st.depth < maxDepth ? prepareLightDistances(ctx, region, ray, tEnd, channel, st.pointLightsByPhotons)
                                 : LightDistanceSegment{};
+        if (guided) lightDistances.guide = st.guide;
         if (lightDistances.active) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
 
-        // Delta tracking to the next real collision, or to tEnd; the
-        // collision callback returns false once the path scattered or was absorbed.
-        bool scattered = false;
-        deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
-            evalMedia(ctx, region, x, mp);
-            ++ctx.counters.marchSamples;
-            // Emission: sigma_a L_e / sigma_maj at every tentative collision.
-            if (!isBlack(mp.emission)) add(beta * mp.sigma_a * mp.emission / sigmaMaj, st.depth);
-            float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
-            float u = rng.uniform() * sigmaMaj;
-            if (u < sa) {
-                beta = Color(0);  // absorbed
-                return false;
-            }
-            if (u >= sa + ss) return true;  // null collision
-            // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
-            beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+        // A real scattering event at x (media mp there): next-event
+        // estimation, then the next direction (the guide's or the phase's).
+        // False when max_depth ends the path.
+        auto scatterAt = [&](const Vec3& x, float t, const MediumPoint& mp) {
             if (++st.depth > maxDepth) {
                 beta = Color(0);
                 return false;
             }
-            const float* weights =
-                lightDistances.active ? trackingWeights(ctx, lightDistances, dot(x - ray.o, ray.d), mp) : nullptr;
-            add(beta * directLight(ctx, region, ScatterVertex::inMedium(x, ray.d, mp.phase), rng,
-                                   nextEventOptions(st, weights)),
-                st.depth);
-            float pdf;
+            ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
+            const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
+            const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
+            add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, weights)), st.depth);
+            float pdf = 0;
             const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-            Vec3 wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
+            Vec3 wi;
+            if (guidedDirection) {
+                Color w(0);
+                wi = st.guide->sampleDirection(ctx, u0, u1, u2, w, pdf);
+                beta *= pdf > 0 ? w : Color(0);
+            } else {
+                wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
+            }
             st.lastPdf = pdf;
             st.specular = false;
             st.lastPoint = x;
             ray = Ray{x, wi};
-            scattered = true;
-            return false;
-        });
+            return true;
+        };
+
+        bool scattered = false;
+        if (guided) {
+            const GuidedFlight flight = st.guide->sampleFlight(ctx, rng, mp);
+            beta *= flight.weight;
+            if (flight.scattered && !isBlack(beta)) {
+                ++ctx.counters.marchSamples;
+                scattered = scatterAt(ray.at(flight.t), flight.t, mp);
+            }
+        } else {
+            // Delta tracking to the next real collision, or to tEnd; the
+            // collision callback returns false once the path scattered or
+            // was absorbed.
+            deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+                evalMedia(ctx, region, x, mp);
+                ++ctx.counters.marchSamples;
+                // Emission: sigma_a L_e / sigma_maj at every tentative collision.
+                if (!isBlack(mp.emission)) add(beta * mp.sigma_a * mp.emission / sigmaMaj, st.depth);
+                float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
+                float u = rng.uniform() * sigmaMaj;
+                if (u < sa) {
+                    beta = Color(0);  // absorbed
+                    return false;
+                }
+                if (u >= sa + ss) return true;  // null collision
+                // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
+                beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+                scattered = scatterAt(x, dot(x - ray.o, ray.d), mp);
+                return false;
+            });
+        }
         if (isBlack(beta)) return result(0.f);
         if (scattered) {
             if (!roulette(beta, st.depth, rng)) return result(0.f);

@@ -8,6 +8,8 @@
 //  - next-event estimation to every light at every scattering vertex with
 //    ratio-tracking transmittance; sphere lights are also hit by the path and
 //    the two strategies meet by the power heuristic;
+//  - with a guide (path_guide.h), its free flights and directions instead
+//    wherever it takes them;
 //  - phase-mixture sampling, the shared surface event, Russian roulette
 //    after RouletteMinDepth events; max_depth counts scattering events
 //    (media and diffuse surfaces).
@@ -20,6 +22,10 @@
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
+class PathGuide;
+}
+
+namespace vdbmarch {
 
 // Where a path stands when the loop takes it over.
 struct PathState {
@@ -30,6 +36,9 @@ struct PathState {
     // Next-event estimation leaves point and spot lights out (photons carry
     // their multiply scattered light: near them it has unbounded variance).
     bool pointLightsByPhotons = false;
+    // Free flights and medium directions by this guide where it takes them
+    // (path_guide.h); null: delta tracking and phase sampling.
+    const PathGuide* guide = nullptr;
 };
 
 struct PathRadiance {

@@ -160,8 +160,9 @@ TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
     EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), c.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
     EXPECT_EQ(a.counters.marchSamples, c.counters.marchSamples);
     // Photons are re-traced when a photon map or a cache is used (never by
-    // the reference tracer).
-    const bool photonsUsed = method != Method::Reference && (li == LiSource::Photons || method == Method::Guided);
+    // the reference tracer; guided path tracing refines its guide).
+    const bool photonsUsed = method == Method::GuidedPath || (method != Method::Reference &&
+                                                             (li == LiSource::Photons || method == Method::Guided));
     EXPECT_EQ(a.photonPasses, photonsUsed ? 4 : 1);
     double sum = 0;
     for (float v : a.image.rgba) sum += v;
@@ -346,7 +347,7 @@ TEST_P(VdbSingleScattering, MatchesClosedFormAlongTheAxis) {
     const double sigmaS = 3, sigmaA = 1, g = 0.5, E = 2, Nh = 20 * 0.05 * 0.5;  // density 0.5
     // The uniform marcher's pixels vary only by the random offset; the
     // reference's by whole paths; the other marchers' by their sampled steps.
-    const int spp = GetParam() == Method::Uniform ? 2 : GetParam() == Method::Reference ? 64 : 16;
+    const int spp = GetParam() == Method::Uniform ? 2 : isPathTracer(GetParam()) ? 64 : 16;
     auto scene = sceneFromJson(str(R"({"camera": {"type": "orthographic", "position": [0.975, 0.975, 3],
         "look_at": [0.975, 0.975, 0], "width_world": 0.6, "resolution": [32, 32]},
         "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": )", E, R"(}],

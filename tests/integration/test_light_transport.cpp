@@ -44,7 +44,7 @@ std::array<SampleStats, 4> furnaceRenders(Method method, LiSource li, const std:
             "media": [{"type": "vdb", "file": ")", vdb, R"(", "sigma_a": 1, "sigma_s": 1, "g": 0.7,
                        "emission": )", emission, R"(}],
             "photons": {"count": 100000, "k": 100},
-            "render": {"max_depth": 64, "seed": )", 100 + run, R"(, "spp": )", method == Method::Reference ? 16 : 4,
+            "render": {"max_depth": 64, "seed": )", 100 + run, R"(, "spp": )", isPathTracer(method) ? 16 : 4,
                                        R"(, "li": ")", liSourceName(li), R"("}})"));
         scene->desc.render.method = method;
         RenderResult r = renderImage(*scene);
@@ -98,7 +98,7 @@ std::vector<std::tuple<Method, LiSource>> furnaceCases() {
     std::vector<std::tuple<Method, LiSource>> cases;
     for (Method m : marcherMethods())
         for (LiSource li : {LiSource::Path, LiSource::Photons})
-            if (m != Method::Reference || li == LiSource::Path) cases.push_back({m, li});  // the reference has no L_i source
+            if (!isPathTracer(m) || li == LiSource::Path) cases.push_back({m, li});  // path tracers have no L_i source
     return cases;
 }
 
@@ -109,7 +109,7 @@ INSTANTIATE_TEST_SUITE_P(Methods, EmissiveFurnace, ::testing::ValuesIn(furnaceCa
 std::vector<std::tuple<Method, LiSource>> blackbodyFurnaceCases() {
     std::vector<std::tuple<Method, LiSource>> cases;
     for (const auto& c : furnaceCases())
-        if (std::get<0>(c) == Method::Reference || std::get<1>(c) == LiSource::Photons) cases.push_back(c);
+        if (isPathTracer(std::get<0>(c)) || std::get<1>(c) == LiSource::Photons) cases.push_back(c);
     return cases;
 }
 

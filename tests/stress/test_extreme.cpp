@@ -167,7 +167,7 @@ TEST_P(ScaleStress, SameOpticalDepthAtAnyScaleAndOffset) {
         R"(, "resolution": [8, 8]},
         "media": [{"type": "vdb", "file": ")", vdb, R"(", "sigma_a": )", sigma, R"(, "sigma_s": 0,
                    "transform": {"translate": [)", offset, R"(, 0, 0]}}],
-        "render": {"method": ")", methodName(method), R"(", "spp": )", method == Method::Reference ? 32 : 1,
+        "render": {"method": ")", methodName(method), R"(", "spp": )", isPathTracer(method) ? 32 : 1,
         R"(, "seed": 2}})"));
     RenderResult r = renderImage(*scene);
     expectAllFinite(r);

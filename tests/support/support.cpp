@@ -189,6 +189,32 @@ ChannelStats pixelStats(const Image& img, int channel) {
     return {s.mean(), s.stdError()};
 }
 
+void expectPairedAgreement(const Image& a, const Image& b, const std::string& what) {
+    ASSERT_EQ(a.width, b.width);
+    ASSERT_EQ(a.height, b.height);
+    const int W = a.width, H = a.height;
+    for (int q = 0; q < 5; ++q) {
+        const int x0 = q == 0 ? 0 : ((q - 1) % 2) * (W / 2), y0 = q == 0 ? 0 : ((q - 1) / 2) * (H / 2);
+        const int w = q == 0 ? W : W / 2, h = q == 0 ? H : H / 2;
+        for (int c = 0; c < 3; ++c) {
+            SampleStats diff;
+            for (int y = y0; y < y0 + h; ++y)
+                for (int x = x0; x < x0 + w; ++x) diff.add(b.rgb(x, y)[c] - a.rgb(x, y)[c]);
+            EXPECT_NEAR(diff.mean(), 0.0, 4 * diff.stdError()) << what << " region " << q << " channel " << c;
+        }
+    }
+}
+
+std::vector<std::string> cloudSkyWithLightsAndGlass() {
+    return {"camera.resolution=[32,24]", "render.max_depth=6", "environment.scale=0.3",
+            R"(lights=[{"type": "point", "position": [0.05, 0.2, 0.0], "intensity": 0.6},
+                       {"type": "spot", "position": [-1.2, 1.2, 0.5], "direction": [1, -0.9, -0.3], "cone_deg": 12,
+                        "falloff_deg": 4, "intensity": 6},
+                       {"type": "sphere", "position": [0.6, 0.7, -0.4], "radius": 0.05, "power": 8}])",
+            R"(surfaces=[{"shape": "sphere", "transform": {"scale": 0.3, "translate": [0.6, 0.45, 1.2]},
+                          "material": {"type": "dielectric", "ior": 1.5}}])"};
+}
+
 // ---------------------------------------------------------------------------
 // Images
 

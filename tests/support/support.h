@@ -197,6 +197,17 @@ struct ChannelStats {
 // Mean and standard error over pixels of one channel (0-2 colour, 3 alpha).
 ChannelStats pixelStats(const Image& img, int channel);
 
+// Two unbiased renders of the same scene agree: the paired per-pixel
+// differences have zero mean over the image and over each quadrant, per
+// colour channel, within 4 standard errors. `what` names the case.
+void expectPairedAgreement(const Image& a, const Image& b, const std::string& what);
+
+// Overrides of vdb_samples/cloud_sky.json for the unbiasedness checks of the
+// path tracer's samplers: a 32x24 view, max_depth 6, the sky at 0.3, a point
+// light inside the cloud, a spot and a sphere light, and a glass ball in
+// front of it.
+std::vector<std::string> cloudSkyWithLightsAndGlass();
+
 // ---------------------------------------------------------------------------
 // Images
 

@@ -1,0 +1,37 @@
+// Guided path tracing's guide (path_guide.h) from the paper's radiance
+// cache: eq. 16 applied to every path segment instead of the camera ray
+// alone, and the cached incident radiance for directions.
+//
+// Free flights. The segment's active part is cut into bins of the cache's
+// finest cell (at most MaxFlightBins); per bin the media at its midpoint
+// give kappa and sigma_s, and the bins' product of e^{-kappa len} an
+// approximate transmittance T~ (exact in constant media). The scattering
+// collision is drawn from
+//
+//   p(t) = eps p_T(t) + (1 - eps) p_T(t) h(t) / E[h],   p_T ~ sigma_s T~  (eq. 16),
+//
+// h the cached in-scattered radiance towards the ray's origin in the bin
+// (CacheLookup), a truncated exponential inside the bin, with probability
+// P_s = 1 - T~(tEnd) (the analog probability of a collision; at most
+// 1 - MinPass); else the path passes to tEnd. A small floor on every bin's
+// weight keeps the support whole where a midpoint misses a gridded
+// medium's density. The weights use the true sigma_s at the collision and
+// T by ratio tracking, so the estimator is unbiased for any cache, in
+// heterogeneous VDB media too (docs/method.md).
+//
+// Directions. Phase x the cell's cached non-direct incident radiance with a
+// defensive phase share (ProductDirectionSampler), when the cache holds
+// incident radiance (render.product_sampling).
+#pragma once
+
+#include <memory>
+
+#include "cache/radiance_cache.h"
+#include "scene/scene.h"
+#include "transport/path_guide.h"
+
+namespace vdbmarch {
+
+std::unique_ptr<PathGuide> makeCachePathGuide(const Scene& scene, const RadianceCache& cache);
+
+}  // namespace vdbmarch
