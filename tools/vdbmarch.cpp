@@ -76,6 +76,13 @@ int main(int argc, char** argv) {
     render->add_option("--passes", ra.passes,
                        "Render only the camera samples of photon passes FIRST to END-1 (FIRST-END) of a progressive "
                        "render, keeping each pass's sums for merge");
+    render->add_option("--checkpoint", ra.checkpoint,
+                       "Save the render's state to this file every --checkpoint-every seconds and when SIGTERM, SIGINT "
+                       "or SIGUSR1 arrives (then exit with status 75); resume from it when it exists; removed when "
+                       "the render completes");
+    render->add_option("--checkpoint-every", ra.checkpointEvery, "Seconds between checkpoints (default 300)");
+    render->add_option("--resume", ra.resume, "Resume from this checkpoint, which must exist (then as --checkpoint)");
+    render->add_flag("--keep-checkpoint", ra.keepCheckpoint, "Keep the checkpoint file when the render completes");
     render->add_flag("--preview", ra.preview,
                      "A quick look: half the resolution, an eighth of the samples (or of --time), a quarter of the photons");
 

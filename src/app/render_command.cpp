@@ -18,6 +18,7 @@
 #include "parse/frames.h"
 #include "parse/method.h"
 #include "parse/scene_json.h"
+#include "render/checkpoint.h"
 #include "render/render.h"
 #include "scene/scene.h"
 
@@ -75,6 +76,15 @@ void validate(const RenderArgs& a) {
     if (!a.png.empty()) checkWritable(a.png);
     if (!a.stats.empty()) checkWritable(a.stats);
     if (!a.saveScene.empty()) checkWritable(a.saveScene);
+    if (!a.checkpoint.empty() && !a.resume.empty() && a.checkpoint != a.resume)
+        throw InputError(str("--checkpoint ", a.checkpoint, " and --resume ", a.resume,
+                             ": a render resumes from and saves to one file; give one of them"));
+    if (!a.checkpoint.empty()) checkWritable(a.checkpoint);
+    if (!a.resume.empty()) checkWritable(a.resume);
+    if (a.checkpointEvery && !(*a.checkpointEvery > 0 && std::isfinite(*a.checkpointEvery)))
+        throw InputError(str("--checkpoint-every ", *a.checkpointEvery, ": must be a positive number of seconds"));
+    if ((a.checkpointEvery || a.keepCheckpoint) && a.checkpoint.empty() && a.resume.empty())
+        throw InputError("--checkpoint-every and --keep-checkpoint need --checkpoint FILE (or --resume FILE)");
     if (a.spp && *a.spp < 1) throw InputError(str("--spp ", *a.spp, ": must be at least 1"));
     if (a.seed && *a.seed < 0) throw InputError(str("--seed ", *a.seed, ": must be a non-negative integer"));
     if (a.threads && *a.threads < 0)
@@ -153,7 +163,47 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     }
     if (tile.count > 0 || tile.cropped) options.crop = window;
     if (tile.byPasses()) options.passes = std::make_pair(tile.firstPass, tile.endPass);
+
+    // Checkpoints: resume from the file when it is there (--resume: it must
+    // be), save to it every --checkpoint-every seconds and on a signal.
+    const std::string checkpointPath = a.resume.empty() ? a.checkpoint : a.resume;
+    std::optional<RenderCheckpoint> resumed;
+    CheckpointIdentity identity;
+    if (!checkpointPath.empty()) {
+        identity.version = VDBMARCH_VERSION;
+        identity.renderHash = renderHash(desc, a.cache);
+        identity.window = str(window.x0, ",", window.y0, ",", window.x1, ",", window.y1);
+        identity.budget = options.timeBudget > 0 ? str("time ", options.timeBudget, " s")
+                          : tile.byPasses()      ? str("passes ", a.passes, " of ", desc.render.spp, " spp")
+                                                 : str("spp ", desc.render.spp);
+        if (::access(checkpointPath.c_str(), F_OK) == 0) {
+            resumed = readCheckpointFile(checkpointPath, identity);
+            if (resumed->sums.L.size() != size_t(window.width()) * size_t(window.height()))
+                throw InputError(str(checkpointPath, ": the checkpoint holds ", resumed->sums.L.size(),
+                                     " pixels, this render ", window.width() * window.height(), " (damaged)"));
+            if (!a.quiet)
+                std::fprintf(stderr, "vdbmarch: resuming from %s at sample %d (%.1f s spent)\n", checkpointPath.c_str(),
+                             resumed->nextSample, resumed->seconds);
+        } else if (!a.resume.empty()) {
+            throw InputError(str("--resume ", a.resume, ": no such checkpoint (render with --checkpoint ", a.resume,
+                                 " to write one)"));
+        }
+        CheckpointHooks hooks;
+        hooks.everySeconds = a.checkpointEvery.value_or(DefaultCheckpointSeconds);
+        hooks.save = [&](const RenderCheckpoint& c) { writeCheckpointFile(checkpointPath, identity, c); };
+        hooks.stopRequested = [] { return stopSignal() != 0; };
+        hooks.resume = resumed ? &*resumed : nullptr;
+        options.checkpoint = std::move(hooks);
+        stopGracefullyOnSignals();
+    }
     RenderResult r = renderImage(*scene, options);
+    if (r.interrupted) {
+        if (!a.quiet)
+            std::fprintf(stderr, "vdbmarch: stopped by %s after %d samples per pixel; the state is in %s: run the "
+                                 "same command to resume (exit status %d)\n",
+                         strsignal(stopSignal()), r.firstSample + r.spp, checkpointPath.c_str(), ExitCheckpointed);
+        return ExitCheckpointed;
+    }
     if (r.counters.nonFiniteSamples > 0)
         warn(str(r.counters.nonFiniteSamples, " path sample(s) gave NaN or Inf and were dropped"));
 
@@ -181,6 +231,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total));
+    if (!checkpointPath.empty() && !a.keepCheckpoint) std::remove(checkpointPath.c_str());  // the render is whole
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
                      tile.count > 0 ? str("tile ", tile.index, "/", tile.count, " (rows ", r.window.y0, "-", r.window.y1 - 1, ") of ").c_str()
@@ -198,7 +249,8 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
 
 // The arguments of one frame: the frame token of every path option replaced.
 RenderArgs atFrame(RenderArgs a, int frame) {
-    for (std::string* path : {&a.output, &a.png, &a.stats, &a.saveScene, &a.cache}) *path = substituteFrame(*path, frame);
+    for (std::string* path : {&a.output, &a.png, &a.stats, &a.saveScene, &a.cache, &a.checkpoint, &a.resume})
+        *path = substituteFrame(*path, frame);
     return a;
 }
 
@@ -208,7 +260,8 @@ RenderArgs atFrame(RenderArgs a, int frame) {
 // same seed (docs/farm.md, "Frames"); without it, one render.
 int runRender(const RenderArgs& a) {
     const std::vector<std::pair<std::string, std::string>> outputs = {
-        {"-o", a.output}, {"--png", a.png}, {"--stats", a.stats}, {"--save-scene", a.saveScene}};
+        {"-o", a.output},          {"--png", a.png},         {"--stats", a.stats}, {"--save-scene", a.saveScene},
+        {"--checkpoint", a.checkpoint}, {"--resume", a.resume}};
     if (a.frames.empty()) {
         std::vector<std::pair<std::string, std::string>> paths = outputs;
         paths.emplace_back("--cache", a.cache);
@@ -219,7 +272,13 @@ int runRender(const RenderArgs& a) {
     checkFrameOutputs(outputs, frames.size(), a.frames);
     validate(atFrame(a, frames.front()));
     checkFrameInputs(a.input, a.sets, frames, {{"--cache", a.cache}});
-    for (int frame : frames) runFrame(frame, [&] { renderFrame(atFrame(a, frame), frame); });
+    // A frame stopped by a signal ends the run; the frames before it are
+    // done, and running the command again resumes that frame.
+    int status = 0;
+    for (int frame : frames) {
+        runFrame(frame, [&] { status = renderFrame(atFrame(a, frame), frame); });
+        if (status != 0) return status;
+    }
     return 0;
 }
 

@@ -23,7 +23,21 @@ struct RenderArgs {
     std::optional<int> spp, threads, raySamples, shOrder;
     std::optional<long long> seed;
     std::optional<double> step, exposure;
+    // Checkpoints (docs/farm.md, "Checkpoints"): the state file, written every
+    // checkpointEvery seconds and when a signal asks the render to stop;
+    // --resume names one that must exist. Removed when the render completes
+    // unless keepCheckpoint.
+    std::string checkpoint, resume;
+    std::optional<double> checkpointEvery;
+    bool keepCheckpoint = false;
 };
+
+// The exit status of a render stopped by SIGTERM, SIGINT or SIGUSR1 after
+// writing its checkpoint (EX_TEMPFAIL of sysexits.h): run the same command
+// again to resume.
+constexpr int ExitCheckpointed = 75;
+// Seconds between checkpoints unless --checkpoint-every says otherwise.
+constexpr double DefaultCheckpointSeconds = 300;
 
 // The options of `render` that override scene keys (--spp -> render.spp, ...).
 const SceneOptionTable<RenderArgs>& renderSceneOptions();

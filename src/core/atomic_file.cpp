@@ -82,6 +82,24 @@ void removeTemporaryFilesOnInterrupt() {
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, removeTempsAndReraise);
 }
 
+namespace {
+volatile std::sig_atomic_t gStopSignal = 0;
+
+extern "C" void requestStop(int sig) {
+    if (gStopSignal != 0) {  // the second one: stop now, as without checkpoints
+        removeTempsAndReraise(sig == SIGUSR1 ? SIGTERM : sig);
+        return;
+    }
+    gStopSignal = sig;
+}
+}  // namespace
+
+void stopGracefullyOnSignals() {
+    for (int sig : {SIGINT, SIGTERM, SIGUSR1}) std::signal(sig, requestStop);
+}
+
+int stopSignal() { return int(gStopSignal); }
+
 void AtomicFile::commit() {
     if (mCommitted) return;
     // fsync before rename: otherwise a crash can leave the new name pointing

@@ -35,6 +35,14 @@ private:
 // no partial file behind.
 void removeTemporaryFilesOnInterrupt();
 
+// For renders that checkpoint: the first SIGINT, SIGTERM or SIGUSR1 only
+// records the signal (stopSignal() returns it; 0 before), so the render can
+// save its state at the next sample boundary and exit; a second one removes
+// the temporary files and dies, as removeTemporaryFilesOnInterrupt does
+// (a second SIGUSR1 dies by SIGTERM). SIGHUP keeps dying at once.
+void stopGracefullyOnSignals();
+int stopSignal();
+
 // Throws IoError if the directory that would hold `path` does not exist or is
 // not writable, or if `path` is itself a directory. Called before rendering so
 // a long render does not fail at the very end.

@@ -55,32 +55,24 @@ private:
 
 }  // namespace
 
+AovSums::AovSums(const AovSet& aovs, size_t pixels) {
+    if (aovs.depth) {
+        depth.assign(pixels, 0.0);
+        depthSamples.assign(pixels, 0);
+    }
+    if (aovs.albedo) albedo.assign(pixels, Color(0));
+    if (aovs.normal) normal.assign(pixels, Color(0));
+    if (aovs.splitDirect()) direct.assign(pixels, Color(0));
+}
+
+uint64_t AovSums::bytesPerPixel(const AovSet& a) {
+    return (a.depth ? sizeof(double) + sizeof(uint32_t) + sizeof(float) : 0) +
+           (a.albedo ? sizeof(Color) + 3 * sizeof(float) : 0) + (a.normal ? sizeof(Color) + 3 * sizeof(float) : 0) +
+           (a.splitDirect() ? sizeof(Color) : 0) + (a.direct ? 3 * sizeof(float) : 0) +
+           (a.indirect ? 3 * sizeof(float) : 0);
+}
+
 namespace {
-
-// The AOVs' per-pixel sums (only those render.aovs asks for are allocated).
-struct AovSums {
-    std::vector<double> depth;           // camera-space depth of the samples that met something
-    std::vector<uint32_t> depthSamples;  // how many did
-    std::vector<Color> albedo, normal, direct;
-
-    AovSums(const AovSet& aovs, size_t pixels) {
-        if (aovs.depth) {
-            depth.assign(pixels, 0.0);
-            depthSamples.assign(pixels, 0);
-        }
-        if (aovs.albedo) albedo.assign(pixels, Color(0));
-        if (aovs.normal) normal.assign(pixels, Color(0));
-        if (aovs.splitDirect()) direct.assign(pixels, Color(0));
-    }
-
-    // Bytes per pixel of the sums and the layers written from them.
-    static uint64_t bytesPerPixel(const AovSet& a) {
-        return (a.depth ? sizeof(double) + sizeof(uint32_t) + sizeof(float) : 0) +
-               (a.albedo ? sizeof(Color) + 3 * sizeof(float) : 0) + (a.normal ? sizeof(Color) + 3 * sizeof(float) : 0) +
-               (a.splitDirect() ? sizeof(Color) : 0) + (a.direct ? 3 * sizeof(float) : 0) +
-               (a.indirect ? 3 * sizeof(float) : 0);
-    }
-};
 
 // Random stream of the feature AOVs, apart from the beauty's.
 constexpr uint64_t AovStream = 0x616f7673;
@@ -225,6 +217,29 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const double firstIlluminationSeconds = illumination->stats.seconds;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
 
+    // A resumed render takes the checkpoint's sums, counters and time; the
+    // photon passes are replayed from their seeds when the next sample needs
+    // them (PhotonPasses::advance), so the illumination is the same too.
+    const CheckpointHooks* hooks = options.checkpoint ? &*options.checkpoint : nullptr;
+    int resumeSample = first;
+    RenderCounters resumedCounters;
+    double resumedSeconds = 0;
+    if (hooks && hooks->resume) {
+        const RenderCheckpoint& c = *hooks->resume;
+        if (c.sums.L.size() != pixels || c.nextSample < first || (!timed && c.nextSample > last))
+            throw std::logic_error("renderImage: the checkpoint does not belong to this render");
+        sums = c.sums;
+        open = c.open;
+        result.passSums = c.passSums;
+        aovSums = c.aovs;
+        resumedCounters = c.counters;
+        resumeSample = c.nextSample;
+        resumedSeconds = c.seconds;
+        runStart -= std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            std::chrono::duration<double>(resumedSeconds));
+        result.resumedAt = c.nextSample;
+    }
+
     // One pass renders samples [s0, s1) of every pixel. Each pixel sums its
     // samples in index order, so the image depends only on the final sample
     // count, never on how samples were split into passes or threads.
@@ -271,7 +286,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                             }
                         }
                     tileCounters[size_t(tile)] += ctx.counters;
-                    if (!timed) progress.tick();
+                    if (!timed && !hooks) progress.tick();
                 }
             }, tbb::simple_partitioner());
         });
@@ -316,10 +331,52 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     };
 
 
-    int spp = 0;
-    if (!timed) {
+    // At a sample boundary (`next` samples done): hands the state to the
+    // checkpoint hook when one is due or a stop was asked for; true: stop.
+    auto lastCheckpoint = std::chrono::steady_clock::now();
+    auto checkpointAt = [&](int next) {
+        if (!hooks) return false;
+        const bool stop = hooks->stopRequested && hooks->stopRequested();
+        const auto now = std::chrono::steady_clock::now();
+        if (!stop && std::chrono::duration<double>(now - lastCheckpoint).count() < hooks->everySeconds) return false;
+        RenderCheckpoint c;
+        c.nextSample = next;
+        c.photonPass = illumination->pass;
+        c.seconds = std::chrono::duration<double>(now - runStart).count();
+        c.counters = resumedCounters;
+        for (const auto& t : tileCounters) c.counters += t;
+        c.sums = sums;
+        c.open = open;
+        c.passSums = result.passSums;
+        c.aovs = aovSums;
+        hooks->save(c);
+        lastCheckpoint = std::chrono::steady_clock::now();
+        return stop;
+    };
+
+    int spp = resumeSample - first;
+    if (!timed && !hooks) {
         renderSamples(first, last);
         spp = last - first;
+    } else if (!timed) {
+        // In chunks of whole samples per pixel, about a second each, so a
+        // stop is acted on soon; the sums do not depend on the chunks.
+        int s = resumeSample, chunk = 1;
+        while (s < last) {
+            if (checkpointAt(s)) {
+                result.interrupted = true;
+                break;
+            }
+            const auto c0 = std::chrono::steady_clock::now();
+            const int e = std::min(last, s + chunk);
+            renderSamples(s, e);
+            const double perSample =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count() / double(e - s);
+            chunk = int(std::clamp(std::min(1.0, hooks->everySeconds) / std::max(perSample, 1e-6), 1.0, 4096.0));
+            s = e;
+            progress.set(double(s - first) / double(last - first));
+        }
+        spp = s - first;
     } else {
         // Whole passes of one sample per pixel while the next one is expected
         // to finish within the budget (which also covers loading, measured
@@ -327,6 +384,10 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         // photon pass is expected to take as long as the first photons did.
         double lastPass = 0;
         do {
+            if (checkpointAt(first + spp)) {
+                result.interrupted = true;
+                break;
+            }
             auto p0 = std::chrono::steady_clock::now();
             const double photonsBefore = illumination->stats.seconds;
             renderSamples(spp, spp + 1);
@@ -344,13 +405,19 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         progress.set(1.0);
     }
     result.spp = spp;
+    if (result.interrupted) {
+        result.counters = resumedCounters;
+        for (const auto& c : tileCounters) result.counters += c;
+        return result;
+    }
     result.illuminationSeconds = illumination->stats.seconds;
     result.photons = illumination->stats.photons;
     result.photonPasses = illumination->pass + 1;
     closePass();
     result.image = sums.average(ww, wh);
     result.layers = aovLayers(aovs, aovSums, sums.L, spp);
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() + resumedSeconds;
+    result.counters = resumedCounters;
     for (const auto& c : tileCounters) result.counters += c;
     return result;
 }

@@ -9,12 +9,28 @@
 #include <vector>
 
 #include "core/stats.h"
+#include "parse/scene_desc.h"
 #include "image/exr_io.h"
 #include "image/image.h"
 #include "illumination/illumination.h"
 #include "scene/scene.h"
 
 namespace vdbmarch {
+
+struct RenderCheckpoint;
+
+// Checkpoints (render --checkpoint, docs/farm.md): at sample boundaries the
+// render hands its whole state to `save`, every `everySeconds` and when
+// `stopRequested` says so (a signal); then, if a stop was requested, it
+// returns with RenderResult::interrupted set. A render given `resume`
+// continues from that state: its image is bit-identical to an
+// uninterrupted one.
+struct CheckpointHooks {
+    double everySeconds = 300;
+    std::function<void(const RenderCheckpoint&)> save;
+    std::function<bool()> stopRequested;
+    const RenderCheckpoint* resume = nullptr;
+};
 
 struct RenderOptions {
     bool progress = false;  // progress bar on stderr
@@ -33,6 +49,7 @@ struct RenderOptions {
     // (render --passes): the part of a progressive render one machine takes.
     // The result keeps each pass's sums (RenderResult::passSums) for merge.
     std::optional<std::pair<int, int>> passes;
+    std::optional<CheckpointHooks> checkpoint;
 };
 
 // An RGB sum in double: thousands of samples add up without the float
@@ -73,6 +90,31 @@ struct PixelSums {
     Image average(int width, int height) const;
 };
 
+// The AOVs' per-pixel sums (only those render.aovs asks for are allocated).
+struct AovSums {
+    std::vector<double> depth;           // camera-space depth of the samples that met something
+    std::vector<uint32_t> depthSamples;  // how many did
+    std::vector<Color> albedo, normal, direct;
+
+    AovSums() = default;
+    AovSums(const AovSet& aovs, size_t pixels);
+    // Bytes per pixel of the sums and the layers written from them.
+    static uint64_t bytesPerPixel(const AovSet& a);
+};
+
+// Everything a render has accumulated at a sample boundary: samples
+// [firstSample, nextSample) of every pixel are in the sums.
+struct RenderCheckpoint {
+    int nextSample = 0;
+    int photonPass = 0;   // the photon pass the illumination was at
+    double seconds = 0;   // the run's time so far (counts in --time)
+    RenderCounters counters;
+    PixelSums sums{0};
+    PassSums open;                    // the pass being rendered (pass -1: none)
+    std::vector<PassSums> passSums;   // with RenderOptions::passes: the passes closed so far
+    AovSums aovs;
+};
+
 struct RenderResult {
     Image image;          // the pixels of `window` (the whole frame unless cropped)
     PixelRect window;
@@ -89,6 +131,10 @@ struct RenderResult {
     std::vector<PassSums> passSums;  // with RenderOptions::passes: each pass rendered, in order
     int firstSample = 0;             // of the samples rendered (0 unless RenderOptions::passes)
     int totalPhotonPasses = 1;       // the passes of the whole render.spp
+    // A checkpoint stop (CheckpointHooks::stopRequested): the state was
+    // saved at sample `spp` and nothing else is valid.
+    bool interrupted = false;
+    int resumedAt = -1;  // the sample a resumed render started from
 };
 
 // Depth AOV of a pixel whose samples met nothing: far, but finite so that

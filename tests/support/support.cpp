@@ -82,6 +82,8 @@ std::string shellQuote(const std::string& s) {
     return q + "'";
 }
 
+std::string vdbmarchBinary() { return VDBMARCH_BINARY; }
+
 CliResult runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& captureDir,
                  int timeoutSeconds) {
     std::string cmd = shellQuote(VDBMARCH_BINARY);

@@ -87,6 +87,9 @@ struct CliResult {
 
 std::string shellQuote(const std::string& s);
 
+// The vdbmarch executable the tests run (shell-quoted use: shellQuote).
+std::string vdbmarchBinary();
+
 // Runs `vdbmarch args...` in `cwd` (under `timeout`, so a product bug cannot
 // hang the suite). stdout and stderr are captured into files in `captureDir`,
 // which should not be the directory whose contents a test inspects.

@@ -1,0 +1,169 @@
+#include "render/checkpoint.h"
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/hash.h"
+
+namespace vdbmarch {
+
+namespace {
+
+constexpr int CheckpointFormat = 1;
+const char* const Magic = "vdbmarch checkpoint ";
+
+template <typename T>
+void putArray(std::string& out, const std::vector<T>& v) {
+    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+
+nlohmann::json passHeader(const PassSums& p) { return {{"pass", p.pass}, {"samples", p.samples}, {"pixels", p.L.size()}}; }
+
+void putPass(std::string& out, const PassSums& p) {
+    putArray(out, p.L);
+    putArray(out, p.T);
+}
+
+// Reads the arrays back in the order they were written, never past the end.
+class Reader {
+public:
+    Reader(const std::string& path, const char* data, size_t size) : mPath(path), mData(data), mSize(size) {}
+    template <typename T>
+    void array(std::vector<T>& v, size_t n) {
+        const size_t bytes = n * sizeof(T);
+        if (n > mSize / sizeof(T) || mAt + bytes > mSize)
+            throw InputError(str(mPath, ": the checkpoint's arrays are shorter than its header says (damaged)"));
+        v.resize(n);
+        if (bytes) std::memcpy(v.data(), mData + mAt, bytes);
+        mAt += bytes;
+    }
+    void pass(PassSums& p, const nlohmann::json& h) {
+        p.pass = h.at("pass").get<int>();
+        p.samples = h.at("samples").get<int>();
+        const size_t n = h.at("pixels").get<size_t>();
+        array(p.L, n);
+        array(p.T, n);
+    }
+    bool done() const { return mAt == mSize; }
+
+private:
+    std::string mPath;
+    const char* mData;
+    size_t mSize, mAt = 0;
+};
+
+}  // namespace
+
+void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, const RenderCheckpoint& c) {
+    const RenderCounters& k = c.counters;
+    nlohmann::json h = {
+        {"version", id.version},
+        {"render_hash", id.renderHash},
+        {"window", id.window},
+        {"budget", id.budget},
+        {"next_sample", c.nextSample},
+        {"photon_pass", c.photonPass},
+        {"seconds", c.seconds},
+        {"counters",
+         {k.cameraRays, k.surfaceHits, k.marchSamples, k.liSamples, k.shadowRays, k.shadowSamples, k.nonFiniteSamples,
+          k.marchedLength, k.skippedLength}},
+        {"pixels", c.sums.L.size()},
+        {"sums_samples", c.sums.samples},
+        {"open", passHeader(c.open)},
+        {"aovs",
+         {{"depth", c.aovs.depth.size()},
+          {"albedo", c.aovs.albedo.size()},
+          {"normal", c.aovs.normal.size()},
+          {"direct", c.aovs.direct.size()}}},
+    };
+    nlohmann::json passes = nlohmann::json::array();
+    for (const PassSums& p : c.passSums) passes.push_back(passHeader(p));
+    h["passes"] = passes;
+    std::string out = str(Magic, CheckpointFormat, "\n", h.dump(), "\n");
+    putArray(out, c.sums.L);
+    putArray(out, c.sums.T);
+    putPass(out, c.open);
+    for (const PassSums& p : c.passSums) putPass(out, p);
+    putArray(out, c.aovs.depth);
+    putArray(out, c.aovs.depthSamples);
+    putArray(out, c.aovs.albedo);
+    putArray(out, c.aovs.normal);
+    putArray(out, c.aovs.direct);
+    const uint64_t hash = fnv1a64(out);
+    out.append(reinterpret_cast<const char*>(&hash), sizeof hash);
+    writeTextFileAtomic(path, out);
+}
+
+RenderCheckpoint readCheckpointFile(const std::string& path, const CheckpointIdentity& expected) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(str(path, ": cannot read the checkpoint (", std::strerror(errno), ")"));
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    const std::string bytes = buffer.str();
+    const std::string magic = str(Magic, CheckpointFormat, "\n");
+    if (bytes.compare(0, std::strlen(Magic), Magic) != 0)
+        throw InputError(str(path, ": not a vdbmarch checkpoint"));
+    if (bytes.compare(0, magic.size(), magic) != 0)
+        throw InputError(str(path, ": a checkpoint of another format (this build reads format ", CheckpointFormat, ")"));
+    uint64_t stored = 0;
+    if (bytes.size() < magic.size() + sizeof stored)
+        throw InputError(str(path, ": the checkpoint is truncated (", bytes.size(), " bytes)"));
+    const size_t body = bytes.size() - sizeof stored;
+    std::memcpy(&stored, bytes.data() + body, sizeof stored);
+    if (fnv1a64(bytes.data(), body) != stored)
+        throw InputError(str(path, ": the checkpoint is damaged or truncated (its checksum does not match); "
+                               "delete it to render from the start"));
+    const size_t eol = bytes.find('\n', magic.size());
+    if (eol == std::string::npos || eol >= body) throw InputError(str(path, ": the checkpoint has no header"));
+    RenderCheckpoint c;
+    try {
+        const nlohmann::json h = nlohmann::json::parse(bytes.begin() + long(magic.size()), bytes.begin() + long(eol));
+        auto expect = [&](const char* key, const std::string& want, const char* what) {
+            const std::string got = h.at(key).get<std::string>();
+            if (got != want)
+                throw InputError(str(path, ": the checkpoint was written for ", what, " (", got, "; this render: ", want,
+                                     "); delete it, or render what it was written for"));
+        };
+        expect("version", expected.version, "another vdbmarch version");
+        expect("render_hash", expected.renderHash, "another scene or other settings (render hash)");
+        expect("window", expected.window, "other pixels (tile or crop)");
+        expect("budget", expected.budget, "another sample budget");
+        c.nextSample = h.at("next_sample").get<int>();
+        c.photonPass = h.at("photon_pass").get<int>();
+        c.seconds = h.at("seconds").get<double>();
+        const auto& k = h.at("counters");
+        RenderCounters& r = c.counters;
+        uint64_t* ints[] = {&r.cameraRays, &r.surfaceHits, &r.marchSamples, &r.liSamples,
+                            &r.shadowRays, &r.shadowSamples, &r.nonFiniteSamples};
+        for (size_t i = 0; i < 7; ++i) *ints[i] = k.at(i).get<uint64_t>();
+        r.marchedLength = k.at(7).get<double>();
+        r.skippedLength = k.at(8).get<double>();
+        Reader read(path, bytes.data() + eol + 1, body - eol - 1);
+        const size_t pixels = h.at("pixels").get<size_t>();
+        read.array(c.sums.L, pixels);
+        read.array(c.sums.T, pixels);
+        c.sums.samples = h.at("sums_samples").get<int>();
+        read.pass(c.open, h.at("open"));
+        for (const auto& p : h.at("passes")) {
+            c.passSums.emplace_back();
+            read.pass(c.passSums.back(), p);
+        }
+        const auto& a = h.at("aovs");
+        read.array(c.aovs.depth, a.at("depth").get<size_t>());
+        read.array(c.aovs.depthSamples, a.at("depth").get<size_t>());
+        read.array(c.aovs.albedo, a.at("albedo").get<size_t>());
+        read.array(c.aovs.normal, a.at("normal").get<size_t>());
+        read.array(c.aovs.direct, a.at("direct").get<size_t>());
+        if (!read.done()) throw InputError(str(path, ": the checkpoint has bytes its header does not describe (damaged)"));
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(str(path, ": the checkpoint's header is not what this build writes (", e.what(), ")"));
+    }
+    return c;
+}
+
+}  // namespace vdbmarch
