@@ -2,7 +2,8 @@
 # SlurmTiledRender (ctest -L slurm): a real Slurm scheduler on loopback
 # (tools/farm/slurm_local.sh) runs a 4-tile render submitted by
 # tools/farm/slurm_submit.sh; the merged image must be bit-identical to the same
-# render in one process. Also: a failing render task makes --wait fail, the
+# render in one process. Also: a tile task requeued mid-render resumes from
+# its checkpoint and the merge stays bit-identical; a failing render task makes --wait fail, the
 # merge is cancelled and no output is written; when vdbmarch has --frames, a
 # 2-frame x 2-tile array over a shot whose frames are different volumes.
 # Exit 77 (skipped) only when the Slurm or munge binaries are not installed.
@@ -70,6 +71,32 @@ step "tiled render merged; rendering the same scene in one process"
 "$VDBMARCH" compare "$TMP/out/merged.exr" "$TMP/single.exr" --identical \
   || { echo "test_slurm: FAIL: the merged Slurm render differs from the single-process render"; exit 1; }
 step "merged == single: bit-identical"
+
+# --- a tile task requeued mid-render (as preemption does) saves its state on
+# SIGTERM, and the requeued task resumes from it: the merge is still
+# bit-identical to one process
+RQ_OPTS=(--res 96x72 --spp 300 --seed 7)
+step "submitting 2 tiles at ${RQ_OPTS[*]}, checkpointing every 0.3 s"
+sub=$(timeout 60 bash "$ROOT/tools/farm/slurm_submit.sh" --tiles 2 --checkpoint-every 0.3 --vdbmarch "$VDBMARCH" \
+  --workdir "$TMP/rq" -o "$TMP/out/rq.exr" "$SCENE" -- "${RQ_OPTS[@]}")
+rq_job=$(sed -n 's/^render_job=//p' <<<"$sub")
+ck="$TMP/rq/rq.tile_0of2.exr.ckpt"
+for i in $(seq 600); do [ -f "$ck" ] && break; sleep 0.1; done
+[ -f "$ck" ] || { echo "test_slurm: FAIL: task 0 wrote no checkpoint"; exit 1; }
+step "task ${rq_job}_0 has a checkpoint: requeuing it"
+scontrol requeue "${rq_job}_0"
+for i in $(seq 1200); do [ -f "$TMP/out/rq.exr" ] && break; sleep 0.1; done
+[ -f "$TMP/out/rq.exr" ] || { tail -n 20 "$TMP"/rq/logs/*.log; echo "test_slurm: FAIL: no merged image after the requeue"; exit 1; }
+log0=$(ls "$TMP"/rq/logs/rq.render.*_0.log)
+cat "$log0"
+grep -q 'stopped with its state' "$log0" || { echo "test_slurm: FAIL: task 0 did not save its state when requeued"; exit 1; }
+grep -q '(restart 1)' "$log0" || { echo "test_slurm: FAIL: task 0 did not run again"; exit 1; }
+grep -q 'resuming from .*rq.tile_0of2.exr.ckpt' "$log0" || { echo "test_slurm: FAIL: task 0 started again from nothing"; exit 1; }
+[ ! -e "$ck" ] || { echo "test_slurm: FAIL: the checkpoint was not removed after the resumed task completed"; exit 1; }
+"$VDBMARCH" render "$SCENE" "${RQ_OPTS[@]}" -q -o "$TMP/rq_single.exr"
+"$VDBMARCH" compare "$TMP/out/rq.exr" "$TMP/rq_single.exr" --identical \
+  || { echo "test_slurm: FAIL: the render with a requeued task differs from the single-process render"; exit 1; }
+step "requeued task resumed; merged == single: bit-identical"
 
 # --- a failing task: --wait must fail, show the log, cancel the merge, write nothing
 step "submitting a render whose tasks fail"

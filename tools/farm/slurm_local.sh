@@ -176,7 +176,9 @@ SlurmdPort=$p2
 SlurmUser=$user
 SlurmdUser=$user
 AuthType=auth/munge
-AuthInfo=socket=$SOCK
+# cred_expire also sets how long a requeued job waits before it may start
+# again (default 120 s); a test cluster requeues within seconds
+AuthInfo=socket=$SOCK,cred_expire=5
 CredType=cred/munge
 StateSaveLocation=$STATE/ctld
 SlurmdSpoolDir=$STATE/spool
@@ -194,8 +196,9 @@ JobCompType=jobcomp/none
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 SchedulerType=sched/backfill
-# a test cluster: start the next tasks at once, not batched every few seconds
-SchedulerParameters=batch_sched_delay=0,sched_min_interval=100000
+# a test cluster: start the next tasks at once, not batched every few seconds,
+# and look at pending jobs every second (a requeued task becomes eligible later)
+SchedulerParameters=batch_sched_delay=0,sched_min_interval=100000,sched_interval=1
 MpiDefault=none
 MailProg=/bin/true
 ReturnToService=2

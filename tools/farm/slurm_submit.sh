@@ -22,6 +22,12 @@
 #                          .exr and the frame token)
 #   --sbatch ARG           one more sbatch argument for both jobs (repeatable),
 #                          e.g. --sbatch --time=1:00:00 --sbatch --account=fx
+#   --checkpoint-every S   each task saves its render's state every S seconds
+#                          (default 300) to its output + .ckpt, and when Slurm
+#                          signals it: a preempted or requeued task resumes
+#                          where it stopped (vdbmarch render --checkpoint)
+#   --signal-before S      ask for SIGUSR1 S seconds before a task's time
+#                          limit (default 60): the task saves and requeues itself
 #   --wait                 wait for the jobs; exit 1, showing the logs of the
 #                          failed jobs, unless every task and the merge succeeded
 #   --dry-run              write the job scripts, print the sbatch commands, submit nothing
@@ -32,6 +38,12 @@
 # (sbatch --dependency=afterok:<array> --kill-on-invalid-dep=yes) runs
 # `vdbmarch merge` once per frame into OUT, logging to WORKDIR/logs/NAME.merge.<jobid>.log.
 # Prints render_job=<id> and merge_job=<id> (none without tiling) on stdout.
+# Render tasks are submitted with --requeue and --signal=B:USR1@S: on SIGUSR1
+# (the time limit is near) a task forwards it to vdbmarch, which saves its
+# checkpoint and exits 75, and the task requeues itself; on SIGTERM (Slurm
+# preempting or requeuing it; Slurm signals every process of the task) the
+# task waits for vdbmarch to save. The requeued task resumes from the
+# checkpoint; the merged image is bit-identical to an uninterrupted render.
 set -euo pipefail
 
 prog=$(basename "$0")
@@ -40,7 +52,7 @@ fail() { echo "$prog: $*" >&2; exit 1; }
 say() { echo "$prog: $*" >&2; }
 usage() { sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//' >&2; exit "${1:-2}"; }
 
-TILES=1 FRAMES="" OUT="" WORKDIR="" VDBMARCH="" PARTITION="" CPT=1 MAXRUN="" JOBNAME=""
+TILES=1 FRAMES="" OUT="" WORKDIR="" VDBMARCH="" PARTITION="" CPT=1 MAXRUN="" JOBNAME="" CKPT_EVERY=300 SIGNAL_BEFORE=60
 WAIT=0 DRY=0 SCENE=""
 SBATCH_EXTRA=() RENDER_EXTRA=()
 
@@ -57,6 +69,8 @@ while [ $# -gt 0 ]; do
     --cpus-per-task) need "$@"; CPT=$2; shift 2 ;;
     --max-running) need "$@"; MAXRUN=$2; shift 2 ;;
     --job-name) need "$@"; JOBNAME=$2; shift 2 ;;
+    --checkpoint-every) need "$@"; CKPT_EVERY=$2; shift 2 ;;
+    --signal-before) need "$@"; SIGNAL_BEFORE=$2; shift 2 ;;
     --sbatch) need "$@"; SBATCH_EXTRA+=("$2"); shift 2 ;;
     --wait) WAIT=1; shift ;;
     --dry-run) DRY=1; shift ;;
@@ -73,6 +87,9 @@ posint() { [[ "$1" =~ ^[0-9]+$ ]] && [ "$((10#$1))" -ge 1 ]; }
 posint "$TILES" || die "--tiles wants a positive integer, not '$TILES'"
 posint "$CPT" || die "--cpus-per-task wants a positive integer, not '$CPT'"
 [ -z "$MAXRUN" ] || posint "$MAXRUN" || die "--max-running wants a positive integer, not '$MAXRUN'"
+[[ "$CKPT_EVERY" =~ ^[0-9]*\.?[0-9]+$ ]] && awk -v s="$CKPT_EVERY" 'BEGIN{exit !(s > 0)}' \
+  || die "--checkpoint-every wants a positive number of seconds, not '$CKPT_EVERY'"
+posint "$SIGNAL_BEFORE" || die "--signal-before wants a positive integer number of seconds, not '$SIGNAL_BEFORE'"
 TILES=$((10#$TILES))
 
 # --- frames: A-B[:STEP] (or a single frame A)
@@ -142,7 +159,7 @@ VDBMARCH=$(abspath "$VDBMARCH")
 # --threads from --cpus-per-task unless the render options choose
 THREADS_ARGS=(--threads "$CPT")
 for a in "${RENDER_EXTRA[@]+"${RENDER_EXTRA[@]}"}"; do
-  case "$a" in --threads|--threads=*) THREADS_ARGS=() ;; -o|--output|--output=*|--tile|--tile=*|--crop|--crop=*|--frames|--frames=*)
+  case "$a" in --threads|--threads=*) THREADS_ARGS=() ;; -o|--output|--output=*|--tile|--tile=*|--crop|--crop=*|--frames|--frames=*|--checkpoint*|--resume*)
     die "RENDER_OPTIONS must not set $a: $prog sets it" ;; esac
 done
 
@@ -172,7 +189,7 @@ SCENE=$(q "$SCENE")
 OUT=$(q "$OUT")
 TILE_PREFIX=$(q "$TILE_PREFIX")
 TOKEN=$(q "$TOKEN")
-TILES=$TILES NFRAMES=$NFRAMES FIRST=$FIRST STEP=$STEP PAD=$PAD
+TILES=$TILES NFRAMES=$NFRAMES FIRST=$FIRST STEP=$STEP PAD=$PAD CKPT_EVERY=$CKPT_EVERY
 EXTRA=($(qa "${THREADS_ARGS[@]+"${THREADS_ARGS[@]}"}" "${RENDER_EXTRA[@]+"${RENDER_EXTRA[@]}"}"))
 T=\${1:-\${SLURM_ARRAY_TASK_ID:?not an array task: give the task index}}
 tile=\$((T % TILES))
@@ -190,8 +207,28 @@ elif [ "\$NFRAMES" -gt 0 ]; then
 else
   out=\$OUT
 fi
-echo "[\$(date +%T)] task \$T on \$(hostname): \$VDBMARCH render \$SCENE \${args[*]} -o \$out \${EXTRA[*]}"
-"\$VDBMARCH" render "\$SCENE" "\${args[@]}" -o "\$out" -q "\${EXTRA[@]}"
+ckpt="\$out.ckpt"
+echo "[\$(date +%T)] task \$T on \$(hostname)\${SLURM_RESTART_COUNT:+ (restart \$SLURM_RESTART_COUNT)}: \$VDBMARCH render \$SCENE \${args[*]} -o \$out --checkpoint \$ckpt \${EXTRA[*]}"
+# vdbmarch runs in the background so this shell can forward SIGUSR1 (sent to
+# it alone, before the time limit); SIGTERM reaches vdbmarch from Slurm
+# directly, so here it only keeps the shell waiting while vdbmarch saves.
+"\$VDBMARCH" render "\$SCENE" "\${args[@]}" -o "\$out" --checkpoint "\$ckpt" --checkpoint-every "\$CKPT_EVERY" "\${EXTRA[@]}" &
+pid=\$!
+trap 'kill -USR1 \$pid 2>/dev/null || true' USR1
+trap ':' TERM
+set +e
+while :; do
+  wait \$pid; rc=\$?
+  kill -0 \$pid 2>/dev/null || break  # else wait returned for a trapped signal
+done
+set -e
+if [ \$rc -eq 75 ]; then
+  echo "[\$(date +%T)] task \$T stopped with its state in \$ckpt; requeued to resume"
+  task=\${SLURM_ARRAY_JOB_ID:+\${SLURM_ARRAY_JOB_ID}_\${SLURM_ARRAY_TASK_ID}}
+  scontrol requeue "\${task:-\$SLURM_JOB_ID}" 2>/dev/null || true  # already requeued when Slurm stopped it
+  exit 75
+fi
+[ \$rc -eq 0 ] || exit \$rc
 echo "[\$(date +%T)] task \$T done"
 EOF
 
@@ -231,8 +268,8 @@ common=(--parsable --job-name="$JOBNAME" --chdir="$WORKDIR")
 [ -z "$PARTITION" ] || common+=(--partition="$PARTITION")
 common+=("${SBATCH_EXTRA[@]+"${SBATCH_EXTRA[@]}"}")
 array="0-$((NTASKS - 1))${MAXRUN:+%$MAXRUN}"
-render_cmd=(sbatch "${common[@]}" --array="$array" --cpus-per-task="$CPT"
-  --output="$WORKDIR/logs/$NAME.render.%A_%a.log" "$RENDER_SCRIPT")
+render_cmd=(sbatch "${common[@]}" --array="$array" --cpus-per-task="$CPT" --requeue --signal="B:USR1@$SIGNAL_BEFORE"
+  --open-mode=append --output="$WORKDIR/logs/$NAME.render.%A_%a.log" "$RENDER_SCRIPT")
 merge_cmd=(sbatch "${common[@]}" --cpus-per-task=1 --kill-on-invalid-dep=yes
   --output="$WORKDIR/logs/$NAME.merge.%j.log")  # + --dependency and the script, below
 
