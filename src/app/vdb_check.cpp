@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <set>
+#include <vector>
 
 #include "core/error.h"
 #include "volume/medium.h"
@@ -47,11 +48,34 @@ std::string lastLine(const std::string& text) {
 
 }  // namespace
 
+double vdbCheckTimeout(uint64_t bytes, double readBytesPerSecond) {
+    const double decode = double(bytes) / 20e6;
+    const double read = readBytesPerSecond > 0 ? double(bytes) / readBytesPerSecond : 0.0;
+    return 8 + decode + 10 * read;
+}
+
+double measureReadSpeed(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return 0;
+    constexpr size_t Limit = size_t(64) << 20, Chunk = size_t(1) << 20;
+    std::vector<char> buf(Chunk);
+    size_t total = 0;
+    const auto start = std::chrono::steady_clock::now();
+    while (total < Limit) {
+        const ssize_t got = ::read(fd, buf.data(), Chunk);
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) break;
+        total += size_t(got);
+    }
+    ::close(fd);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return total == 0 ? 0.0 : double(total) / std::max(seconds, 1e-6);
+}
+
 void checkVdbFileIsolated(const std::string& path, double timeoutSeconds) {
     struct stat st;
     if (::stat(path.c_str(), &st) != 0) throw IoError(str(path, ": cannot open VDB file: ", std::strerror(errno)));
-    // Reading runs at well over 20 MB/s; a valid file never takes this long.
-    if (timeoutSeconds <= 0) timeoutSeconds = 60 + double(st.st_size) / 20e6;
+    if (timeoutSeconds <= 0) timeoutSeconds = vdbCheckTimeout(uint64_t(st.st_size), measureReadSpeed(path));
 
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0) throw IoError(str("cannot create a pipe to check ", path, ": ", std::strerror(errno)));

@@ -7,6 +7,7 @@
 // by the grid extent check of volume/vdb_medium.cpp.)
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -15,10 +16,22 @@
 namespace vdbmarch {
 
 // Runs `vdbmarch check PATH` (this executable) in a child process and waits
-// for it, at most timeoutSeconds (0: automatic, from the file size). Throws
+// for it, at most timeoutSeconds (0: automatic, vdbCheckTimeout of the file's
+// size and this machine's read speed, measured on it). Throws
 // InputError naming the file when it crashed, hung or failed, with the
 // child's message.
 void checkVdbFileIsolated(const std::string& path, double timeoutSeconds = 0);
+
+// The watchdog's limit for a file of `bytes` on a disk that reads
+// `readBytesPerSecond`: 8 s, plus decoding at 20 MB/s (OpenVDB decodes well
+// above that), plus ten times the time to read the bytes. A small file is
+// refused within about 8 s; a large file on a slow disk keeps its margin.
+double vdbCheckTimeout(uint64_t bytes, double readBytesPerSecond);
+
+// Reads up to the first 64 MB of `path` and returns the bytes per second
+// (0 when nothing could be read). The child then reads those bytes from
+// the page cache.
+double measureReadSpeed(const std::string& path);
 
 // The VDB files a scene (or a bare .vdb input) opens, each once.
 std::vector<std::string> vdbFilesOf(const SceneDesc& desc);

@@ -1,5 +1,7 @@
 #include "render/checkpoint.h"
 
+#include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -8,7 +10,6 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/hash.h"
 
 namespace vdbmarch {
 
@@ -17,17 +18,73 @@ namespace {
 constexpr int CheckpointFormat = 1;
 const char* const Magic = "vdbmarch checkpoint ";
 
-template <typename T>
-void putArray(std::string& out, const std::vector<T>& v) {
-    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-}
+// FNV-1a over 64-bit words (the last partial word zero-padded): a checksum
+// against damage and truncation, eight times faster than byte-wise FNV on
+// the hundreds of megabytes of a large frame's sums.
+class WordHash {
+public:
+    void add(const char* p, size_t n) {
+        while (n > 0) {
+            const size_t take = std::min(n, sizeof(uint64_t) - mFill);
+            std::memcpy(reinterpret_cast<char*>(&mWord) + mFill, p, take);
+            mFill += take;
+            p += take;
+            n -= take;
+            if (mFill == sizeof(uint64_t)) flushWord();
+            // Whole words straight from the input.
+            while (mFill == 0 && n >= sizeof(uint64_t)) {
+                std::memcpy(&mWord, p, sizeof mWord);
+                flushWord();
+                p += sizeof(uint64_t);
+                n -= sizeof(uint64_t);
+            }
+        }
+    }
+    uint64_t value() {
+        if (mFill > 0) {
+            std::memset(reinterpret_cast<char*>(&mWord) + mFill, 0, sizeof(uint64_t) - mFill);
+            flushWord();
+        }
+        return mValue;
+    }
+
+private:
+    void flushWord() {
+        mValue = (mValue ^ mWord) * 1099511628211ULL;
+        mWord = 0;
+        mFill = 0;
+    }
+    uint64_t mValue = 1469598103934665603ULL, mWord = 0;
+    size_t mFill = 0;
+};
+
+// Writes the file's bytes and hashes them as they go (no copy of the sums).
+class HashedWriter {
+public:
+    explicit HashedWriter(std::ofstream& out) : mOut(out) {}
+    void bytes(const char* p, size_t n) {
+        mOut.write(p, std::streamsize(n));
+        mHash.add(p, n);
+    }
+    template <typename T>
+    void array(const std::vector<T>& v) {
+        bytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    }
+    void pass(const PassSums& p) {
+        array(p.L);
+        array(p.T);
+    }
+    void finish() {
+        const uint64_t h = mHash.value();
+        mOut.write(reinterpret_cast<const char*>(&h), sizeof h);
+    }
+
+private:
+    std::ofstream& mOut;
+    WordHash mHash;
+};
 
 nlohmann::json passHeader(const PassSums& p) { return {{"pass", p.pass}, {"samples", p.samples}, {"pixels", p.L.size()}}; }
-
-void putPass(std::string& out, const PassSums& p) {
-    putArray(out, p.L);
-    putArray(out, p.T);
-}
 
 // Reads the arrays back in the order they were written, never past the end.
 class Reader {
@@ -84,19 +141,26 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
     nlohmann::json passes = nlohmann::json::array();
     for (const PassSums& p : c.passSums) passes.push_back(passHeader(p));
     h["passes"] = passes;
-    std::string out = str(Magic, CheckpointFormat, "\n", h.dump(), "\n");
-    putArray(out, c.sums.L);
-    putArray(out, c.sums.T);
-    putPass(out, c.open);
-    for (const PassSums& p : c.passSums) putPass(out, p);
-    putArray(out, c.aovs.depth);
-    putArray(out, c.aovs.depthSamples);
-    putArray(out, c.aovs.albedo);
-    putArray(out, c.aovs.normal);
-    putArray(out, c.aovs.direct);
-    const uint64_t hash = fnv1a64(out);
-    out.append(reinterpret_cast<const char*>(&hash), sizeof hash);
-    writeTextFileAtomic(path, out);
+    const std::string head = str(Magic, CheckpointFormat, "\n", h.dump(), "\n");
+    AtomicFile file(path);
+    {
+        std::ofstream out(file.tempPath(), std::ios::binary);
+        HashedWriter w(out);
+        w.bytes(head.data(), head.size());
+        w.array(c.sums.L);
+        w.array(c.sums.T);
+        w.pass(c.open);
+        for (const PassSums& p : c.passSums) w.pass(p);
+        w.array(c.aovs.depth);
+        w.array(c.aovs.depthSamples);
+        w.array(c.aovs.albedo);
+        w.array(c.aovs.normal);
+        w.array(c.aovs.direct);
+        w.finish();
+        out.flush();
+        if (!out) throw IoError(str("cannot write '", path, "': ", std::strerror(errno)));
+    }
+    file.commit();
 }
 
 RenderCheckpoint readCheckpointFile(const std::string& path, const CheckpointIdentity& expected) {
@@ -115,7 +179,9 @@ RenderCheckpoint readCheckpointFile(const std::string& path, const CheckpointIde
         throw InputError(str(path, ": the checkpoint is truncated (", bytes.size(), " bytes)"));
     const size_t body = bytes.size() - sizeof stored;
     std::memcpy(&stored, bytes.data() + body, sizeof stored);
-    if (fnv1a64(bytes.data(), body) != stored)
+    WordHash hash;
+    hash.add(bytes.data(), body);
+    if (hash.value() != stored)
         throw InputError(str(path, ": the checkpoint is damaged or truncated (its checksum does not match); "
                                "delete it to render from the start"));
     const size_t eol = bytes.find('\n', magic.size());

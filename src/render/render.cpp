@@ -345,10 +345,25 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         c.seconds = std::chrono::duration<double>(now - runStart).count();
         c.counters = resumedCounters;
         for (const auto& t : tileCounters) c.counters += t;
-        c.sums = sums;
-        c.open = open;
-        c.passSums = result.passSums;
-        c.aovs = aovSums;
+        // The sums are lent to the checkpoint, not copied (a large frame's
+        // are hundreds of megabytes), and taken back even if saving throws.
+        c.sums = std::move(sums);
+        c.open = std::move(open);
+        c.passSums = std::move(result.passSums);
+        c.aovs = std::move(aovSums);
+        struct GiveBack {
+            RenderCheckpoint& c;
+            PixelSums& sums;
+            PassSums& open;
+            std::vector<PassSums>& passSums;
+            AovSums& aovs;
+            ~GiveBack() {
+                sums = std::move(c.sums);
+                open = std::move(c.open);
+                passSums = std::move(c.passSums);
+                aovs = std::move(c.aovs);
+            }
+        } giveBack{c, sums, open, result.passSums, aovSums};
         hooks->save(c);
         lastCheckpoint = std::chrono::steady_clock::now();
         return stop;

@@ -6,6 +6,9 @@
 // refused with messages naming them, and nothing is written.
 #include <gtest/gtest.h>
 
+#include <map>
+
+#include "image/exr_io.h"
 #include "support/support.h"
 
 using namespace vdbmarch;
@@ -52,6 +55,16 @@ TEST_F(CheckpointCli, SigtermSavesAndTheSameCommandResumesBitIdentical) {
     EXPECT_FALSE(fs::exists(work("ck")));  // removed once the render is whole
     const CliResult same = cli({"compare", "--identical", work("part.exr"), work("whole.exr")});
     EXPECT_EQ(same.exitCode, 0) << same.out;
+    // The header says what an uninterrupted render says (the time counts
+    // both runs).
+    std::map<std::string, std::string> a, b;
+    for (const auto& kv : readExrStringAttributes(work("part.exr"))) a[kv.first] = kv.second;
+    for (const auto& kv : readExrStringAttributes(work("whole.exr"))) b[kv.first] = kv.second;
+    for (const char* key : {"vdbmarch:spp", "vdbmarch:method", "vdbmarch:seed", "vdbmarch:renderHash",
+                            "vdbmarch:photonPasses", "vdbmarch:timeBudget", "vdbmarch:scene"})
+        EXPECT_EQ(a[key], b[key]) << key;
+    EXPECT_EQ(a["vdbmarch:spp"], "2000");
+    EXPECT_GT(std::stod(a["vdbmarch:renderSeconds"]), 0.0);
 }
 
 TEST_F(CheckpointCli, ForeignOrMissingCheckpointsAndBadOptionsAreRefused) {
