@@ -11,6 +11,9 @@ LABELS="${1:-unit|stress}"
 JOBS="${JOBS:-$(nproc)}"
 LAUNCHER=""
 command -v ccache >/dev/null && LAUNCHER="-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"
+# Hash paths relative to the checkout, so a fresh clone elsewhere on this
+# machine (CI clones into a new folder each run) reuses the cache.
+export CCACHE_BASEDIR="$ROOT" CCACHE_NOHASHDIR=true
 # VDBMARCH_SANITIZE adds -fsanitize=address,undefined to every target; UB
 # reports must stop the test, not scroll by.
 cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo $LAUNCHER -DVDBMARCH_SANITIZE=ON \

@@ -18,5 +18,8 @@ fi
 JOBS=$(nproc 2>/dev/null || echo 2)
 LAUNCHER=""
 command -v ccache >/dev/null && LAUNCHER="-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"
+# Hash paths relative to the checkout, so a fresh clone elsewhere on this
+# machine (CI clones into a new folder each run) reuses the cache.
+export CCACHE_BASEDIR="$ROOT" CCACHE_NOHASHDIR=true
 cmake -S "$ROOT" -B "$ROOT/build" -G Ninja -DCMAKE_BUILD_TYPE=Release $LAUNCHER >/dev/null
 cmake --build "$ROOT/build" -j "$JOBS"
