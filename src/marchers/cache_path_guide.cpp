@@ -55,7 +55,7 @@ public:
         std::vector<float>& h = m.stepH;
         steps.clear();
         h.clear();
-        CacheLookup& cache = lookup(ctx);
+        CacheLookup& cache = m.lookup(mCache);
         cache.setDirection(-ray.d);
         MediumPoint mp;
         const bool constant = mRegionConstant[size_t(region)];
@@ -143,17 +143,7 @@ public:
     bool prepareDirection(ThreadContext& ctx, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
                           ScatterVertex& vertex) const override {
         if (!mDirections) return false;
-        MarcherScratch& m = scratch(ctx);
-        if (!m.productQuery) m.productQuery = std::make_unique<RadianceCache::Query>(mCache);
-        const int64_t cell = m.productQuery->find(x);
-        if (cell < 0) return false;
-        const int order = std::min(mCache.incidentOrder, ProductDirectionSampler::MaxOrder);
-        if (!m.productSampler.build(order, mCache.cellIncident(size_t(cell)), mp.phase, rayDir)) return false;
-        vertex.pathSampler = &m.productSampler;
-        vertex.pathPdf = [](const void* s, const Vec3& wi) {
-            return static_cast<const ProductDirectionSampler*>(s)->pdf(wi);
-        };
-        return true;
+        return scratch(ctx).buildProductSampler(mCache, x, rayDir, mp, vertex);
     }
 
     Vec3 sampleDirection(ThreadContext& ctx, float u0, float u1, float u2, Color& weight, float& pdf) const override {
@@ -165,11 +155,6 @@ public:
 
 private:
     static MarcherScratch& scratch(ThreadContext& ctx) { return ctx.extensionAs<MarcherScratch>(); }
-    CacheLookup& lookup(ThreadContext& ctx) const {
-        MarcherScratch& m = scratch(ctx);
-        if (!m.cacheLookup) m.cacheLookup = std::make_unique<CacheLookup>(mCache);
-        return *m.cacheLookup;
-    }
 
     const Scene& mScene;
     const RadianceCache& mCache;

@@ -95,25 +95,24 @@ PathResult SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& 
     }
 }
 
-CacheLookup& SegmentMarcher::cacheLookup(ThreadContext& ctx) const {
-    MarcherScratch& m = scratch(ctx);
-    if (!m.cacheLookup) m.cacheLookup = std::make_unique<CacheLookup>(*mIllumination->cache);
-    return *m.cacheLookup;
+CacheLookup& MarcherScratch::lookup(const RadianceCache& cache) {
+    if (!cacheLookup) cacheLookup = std::make_unique<CacheLookup>(cache);
+    return *cacheLookup;
 }
 
-bool SegmentMarcher::buildProductSampler(ThreadContext& ctx, const Vec3& x, const Vec3& rayDir,
-                                         const MediumPoint& mp) const {
-    MarcherScratch& m = scratch(ctx);
-    const RadianceCache& cache = *mIllumination->cache;
-    if (!m.productQuery) m.productQuery = std::make_unique<RadianceCache::Query>(cache);
-    const int64_t cell = m.productQuery->find(x);
+bool MarcherScratch::buildProductSampler(const RadianceCache& cache, const Vec3& x, const Vec3& rayDir,
+                                         const MediumPoint& mp, ScatterVertex& vertex) {
+    if (!productQuery) productQuery = std::make_unique<RadianceCache::Query>(cache);
+    const int64_t cell = productQuery->find(x);
     if (cell < 0) return false;
     // The non-direct incident radiance there: what the path can find
     // beside next-event estimation (the direct light of delta lights is not
     // in it: a path never finds that).
     const int order = std::min(cache.incidentOrder, ProductDirectionSampler::MaxOrder);
-    const float* incident = cache.cellIncident(size_t(cell));
-    return m.productSampler.build(order, incident, mp.phase, rayDir);
+    if (!productSampler.build(order, cache.cellIncident(size_t(cell)), mp.phase, rayDir)) return false;
+    vertex.pathSampler = &productSampler;
+    vertex.pathPdf = [](const void* s, const Vec3& wi) { return static_cast<const ProductDirectionSampler*>(s)->pdf(wi); };
+    return true;
 }
 
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
@@ -163,13 +162,8 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     // light samples against that same density (MIS).
     ScatterVertex nextEventVertex = vertex;
     const ProductDirectionSampler* product = nullptr;
-    if (mProductSampling && buildProductSampler(ctx, x, rayDir, mp)) {
+    if (mProductSampling && m.buildProductSampler(*mIllumination->cache, x, rayDir, mp, nextEventVertex))
         product = &m.productSampler;
-        nextEventVertex.pathSampler = product;
-        nextEventVertex.pathPdf = [](const void* s, const Vec3& wi) {
-            return static_cast<const ProductDirectionSampler*>(s)->pdf(wi);
-        };
-    }
     Color Li = direct(directLight(ctx, region, nextEventVertex, rng, kNextEvent));
     const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();

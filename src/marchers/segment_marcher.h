@@ -14,6 +14,7 @@
 #include "illumination/illumination.h"
 #include "marchers/marcher.h"
 #include "marchers/ray_pdf.h"
+#include "transport/direct_light.h"
 #include "transport/media_point.h"
 
 namespace vdbmarch {
@@ -53,6 +54,15 @@ struct MarcherScratch final : ThreadContextExtension {
     // The direct / indirect AOVs (render.aovs): the camera path's direct
     // part so far, and that of the last inScattered() result.
     Color direct{0}, liDirect{0};
+
+    // The cache lookup along rays, made on first use.
+    CacheLookup& lookup(const RadianceCache& cache);
+    // Builds productSampler for a direction from x (the path arriving along
+    // rayDir, media mp) from the non-direct incident radiance of x's cell,
+    // and points `vertex`'s pathPdf at it for MIS. False: no cell or no
+    // light there (sample the phase).
+    bool buildProductSampler(const RadianceCache& cache, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
+                             ScatterVertex& vertex);
 };
 
 class SegmentMarcher : public Marcher {
@@ -100,10 +110,7 @@ protected:
     void applyInfiniteTail(int region, Color& beta) const;
 
     static MarcherScratch& scratch(ThreadContext& ctx) { return ctx.extensionAs<MarcherScratch>(); }
-    CacheLookup& cacheLookup(ThreadContext& ctx) const;
-    // Builds the scratch's product sampler for a continuation from x (false:
-    // no cell or no light there; sample the phase).
-    bool buildProductSampler(ThreadContext& ctx, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp) const;
+    CacheLookup& cacheLookup(ThreadContext& ctx) const { return scratch(ctx).lookup(*mIllumination->cache); }
 
     const Scene& mScene;
     std::shared_ptr<const Illumination> mIllumination;

@@ -124,7 +124,6 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
         {"window", id.window},
         {"budget", id.budget},
         {"next_sample", c.nextSample},
-        {"photon_pass", c.photonPass},
         {"seconds", c.seconds},
         {"counters",
          {k.cameraRays, k.surfaceHits, k.marchSamples, k.liSamples, k.shadowRays, k.shadowSamples, k.nonFiniteSamples,
@@ -200,7 +199,6 @@ RenderCheckpoint readCheckpointFile(const std::string& path, const CheckpointIde
         expect("window", expected.window, "other pixels (tile or crop)");
         expect("budget", expected.budget, "another sample budget");
         c.nextSample = h.at("next_sample").get<int>();
-        c.photonPass = h.at("photon_pass").get<int>();
         c.seconds = h.at("seconds").get<double>();
         const auto& k = h.at("counters");
         RenderCounters& r = c.counters;

@@ -237,7 +237,6 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         resumedSeconds = c.seconds;
         runStart -= std::chrono::duration_cast<std::chrono::steady_clock::duration>(
             std::chrono::duration<double>(resumedSeconds));
-        result.resumedAt = c.nextSample;
     }
 
     // One pass renders samples [s0, s1) of every pixel. Each pixel sums its
@@ -331,6 +330,13 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     };
 
 
+    // The counters so far, those of a resumed render's first runs included.
+    auto counters = [&] {
+        RenderCounters total = resumedCounters;
+        for (const auto& t : tileCounters) total += t;
+        return total;
+    };
+
     // At a sample boundary (`next` samples done): hands the state to the
     // checkpoint hook when one is due or a stop was asked for; true: stop.
     auto lastCheckpoint = std::chrono::steady_clock::now();
@@ -341,10 +347,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         if (!stop && std::chrono::duration<double>(now - lastCheckpoint).count() < hooks->everySeconds) return false;
         RenderCheckpoint c;
         c.nextSample = next;
-        c.photonPass = illumination->pass;
         c.seconds = std::chrono::duration<double>(now - runStart).count();
-        c.counters = resumedCounters;
-        for (const auto& t : tileCounters) c.counters += t;
+        c.counters = counters();
         // The sums are lent to the checkpoint, not copied (a large frame's
         // are hundreds of megabytes), and taken back even if saving throws.
         c.sums = std::move(sums);
@@ -421,8 +425,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     }
     result.spp = spp;
     if (result.interrupted) {
-        result.counters = resumedCounters;
-        for (const auto& c : tileCounters) result.counters += c;
+        result.counters = counters();
         return result;
     }
     result.illuminationSeconds = illumination->stats.seconds;
@@ -432,8 +435,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     result.image = sums.average(ww, wh);
     result.layers = aovLayers(aovs, aovSums, sums.L, spp);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() + resumedSeconds;
-    result.counters = resumedCounters;
-    for (const auto& c : tileCounters) result.counters += c;
+    result.counters = counters();
     return result;
 }
 

@@ -102,11 +102,11 @@ struct AovSums {
     static uint64_t bytesPerPixel(const AovSet& a);
 };
 
-// Everything a render has accumulated at a sample boundary: samples
+// Everything a render has accumulated at a sample boundary (the photon pass
+// it was at follows from nextSample): samples
 // [firstSample, nextSample) of every pixel are in the sums.
 struct RenderCheckpoint {
     int nextSample = 0;
-    int photonPass = 0;   // the photon pass the illumination was at
     double seconds = 0;   // the run's time so far (counts in --time)
     RenderCounters counters;
     PixelSums sums{0};
@@ -134,7 +134,6 @@ struct RenderResult {
     // A checkpoint stop (CheckpointHooks::stopRequested): the state was
     // saved at sample `spp` and nothing else is valid.
     bool interrupted = false;
-    int resumedAt = -1;  // the sample a resumed render started from
 };
 
 // Depth AOV of a pixel whose samples met nothing: far, but finite so that
