@@ -57,6 +57,10 @@ int main(int argc, char** argv) {
     render->add_option("--time", ra.timeBudget,
                        "Time budget in seconds for the whole run, instead of --spp: whole passes of one sample "
                        "per pixel while the next fits");
+    render->add_flag("--denoise", ra.denoise,
+                     "Denoise the EXR's RGBA too, keeping the noisy beauty as layer 'noisy' (render.denoise = on; "
+                     "the PNG preview is denoised by default)");
+    render->add_flag("--no-denoise", ra.noDenoise, "Write the PNG preview noisy too (render.denoise = off)");
     render->add_option("--res", ra.res, "Resolution WIDTHxHEIGHT");
     render->add_option("--set", ra.sets, "Override a scene key: key.path=value (JSON value), repeatable");
     render->add_option("--stats", ra.stats, "Write timings and counters as JSON");

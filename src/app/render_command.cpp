@@ -43,6 +43,10 @@ const SceneOptionTable<RenderArgs>& renderSceneOptions() {
         {"--aovs", "render.aovs",
          "Extra EXR layers, comma-separated: depth, albedo, normal, direct, indirect (docs/aovs.md)",
          &RenderArgs::aovs},
+        {"--noise", "render.noise",
+         "Noise target: stop once the estimated RMSE over the image's mean is below this (e.g. 0.02), sampling "
+         "only the pixels still above it; --time or --spp, if given, still cap the render (docs/noise.md)",
+         &RenderArgs::noise},
         {"--sh-order", "cache.sh_order", "SH order of the cache built for guided; 0 = scalar cache (cache.sh_order)",
          &RenderArgs::shOrder},
     };
@@ -50,6 +54,10 @@ const SceneOptionTable<RenderArgs>& renderSceneOptions() {
 }
 
 namespace {
+
+// The samples per pixel a render to a noise target stops at when nothing
+// else caps it.
+constexpr int MaxNoiseTargetSpp = 1 << 16;
 
 // --preview: half the width and height, an eighth of the samples (at least
 // one), a quarter of the photons; everything else as the scene says.
@@ -62,6 +70,16 @@ std::vector<std::string> previewOverrides(const SceneDesc& d) {
 // "guided", or "reference (auto: multiple scattering in open media)".
 std::string methodLabel(const RenderSettings& r) {
     return r.methodAuto ? str(methodName(r.method), " (auto: ", r.methodReason, ")") : std::string(methodName(r.method));
+}
+
+// "; noise 2.1 % (estimated)" for the summary line, with the target's outcome.
+std::string noiseSummary(const RenderSettings& rs, const RenderResult& r) {
+    if (!r.noise.valid) return "";
+    std::string s = str("; noise ", std::round(1000 * r.noise.relative()) / 10, " % (estimated)");
+    if (rs.noise > 0)
+        s += str(", target ", 100 * rs.noise, " % ", r.reachedNoiseTarget ? "reached" : "not reached", " with ",
+                 std::round(r.meanSpp * 10) / 10, " samples per pixel on average");
+    return s;
 }
 
 // Refuses bad option values and unwritable outputs before anything is loaded.
@@ -95,6 +113,9 @@ void validate(const RenderArgs& a) {
         throw InputError(str("--time ", *a.timeBudget, ": must be a positive number of seconds"));
     if (a.timeBudget && a.spp)
         throw InputError("--time and --spp both given: a render is budgeted either by samples or by seconds");
+    if (a.noise && !(*a.noise >= 1e-4 && *a.noise <= 10))
+        throw InputError(str("--noise ", *a.noise, ": must be a relative error between 0.0001 and 10 (e.g. 0.02)"));
+    if (a.denoise && a.noDenoise) throw InputError("--denoise and --no-denoise: give one of them");
     parseTileRequest(a.tile, a.crop, a.passes);
 }
 
@@ -112,6 +133,10 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     s["method"] = methodName(desc.render.method);
     s["method_auto"] = desc.render.methodAuto;
     s["spp"] = r.spp;
+    s["mean_spp"] = r.meanSpp;
+    if (r.noise.valid)
+        s["noise_estimate"] = {{"relative", r.noise.relative()}, {"rmse", r.noise.rmse}, {"mean", r.noise.mean}};
+    if (desc.render.noise > 0) s["noise_target"] = {{"target", desc.render.noise}, {"reached", r.reachedNoiseTarget}};
     if (a.timeBudget) s["time_budget"] = *a.timeBudget;
     s["resolution"] = {r.image.width, r.image.height};
     s["step"] = scene.step;
@@ -134,6 +159,10 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     std::vector<std::string> overrides = a.sets;
     appendSceneOverrides(a, renderSceneOptions(), overrides);
     if (!a.res.empty()) overrides.push_back(resolutionOverride(a.res));
+    // A noise target given here is the budget: the scene's spp no longer caps it.
+    if (a.noise && !a.spp && !a.timeBudget) overrides.push_back(str("render.spp=", MaxNoiseTargetSpp));
+    if (a.denoise) overrides.push_back("render.denoise=\"on\"");
+    if (a.noDenoise) overrides.push_back("render.denoise=\"off\"");
     if (!a.cache.empty() && !endsWith(a.cache, ".vdb"))
         throw InputError(str("--cache ", a.cache, ": the cache must be a .vdb file written by vdbmarch bake"));
     if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
@@ -176,6 +205,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         identity.budget = options.timeBudget > 0 ? str("time ", options.timeBudget, " s")
                           : tile.byPasses()      ? str("passes ", a.passes, " of ", desc.render.spp, " spp")
                                                  : str("spp ", desc.render.spp);
+        if (desc.render.noise > 0) identity.budget += str(", noise ", desc.render.noise);
         if (::access(checkpointPath.c_str(), F_OK) == 0) {
             resumed = readCheckpointFile(checkpointPath, identity);
             if (resumed->sums.L.size() != size_t(window.width()) * size_t(window.height()))
@@ -220,7 +250,10 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         {"vdbmarch:renderSeconds", str(r.seconds)},
         {"vdbmarch:scene", desc.jsonText},
         {RenderHashAttribute, renderHash(desc, a.cache)},
+        {NoiseTargetAttribute, desc.render.noise > 0 ? str(desc.render.noise) : std::string("none")},
+        {"vdbmarch:meanSpp", str(r.meanSpp)},
     };
+    for (auto& kv : noiseAttributes(r.noise)) attrs.push_back(std::move(kv));
     if (desc.frame) attrs.emplace_back("vdbmarch:frame", std::to_string(*desc.frame));
     if (!a.cache.empty()) attrs.emplace_back("vdbmarch:cache", a.cache);
     for (auto& kv : tileAttributes(tile, r)) attrs.push_back(std::move(kv));
@@ -233,7 +266,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total));
     if (!checkpointPath.empty() && !a.keepCheckpoint) std::remove(checkpointPath.c_str());  // the render is whole
     if (!a.quiet)
-        std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s\n",
+        std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s%s\n",
                      tile.count > 0 ? str("tile ", tile.index, "/", tile.count, " (rows ", r.window.y0, "-", r.window.y1 - 1, ") of ").c_str()
                      : tile.cropped ? str("crop ", a.crop, " of ").c_str()
                      : tile.byPasses() ? str("photon passes ", a.passes, " (samples ", r.firstSample, "-", r.firstSample + r.spp - 1, ") of ").c_str() : "",
@@ -243,7 +276,8 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
                          ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s in ",
                                r.photonPasses, r.photonPasses == 1 ? " pass, " : " passes, ").c_str()
                          : "",
-                     loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str());
+                     loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str(),
+                     noiseSummary(desc.render, r).c_str());
     return 0;
 }
 

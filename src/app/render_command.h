@@ -22,7 +22,8 @@ struct RenderArgs {
     std::string method, li, aovs;
     std::optional<int> spp, threads, raySamples, shOrder;
     std::optional<long long> seed;
-    std::optional<double> step, exposure;
+    std::optional<double> step, exposure, noise;
+    bool denoise = false, noDenoise = false;  // --denoise, --no-denoise (render.denoise on / off)
     // Checkpoints (docs/farm.md, "Checkpoints"): the state file, written every
     // checkpointEvery seconds and when a signal asks the render to stop;
     // --resume names one that must exist. Removed when the render completes

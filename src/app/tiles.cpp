@@ -1,6 +1,8 @@
 #include "app/tiles.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -70,17 +72,24 @@ StringAttributes tileAttributes(const TileRequest& r, const RenderResult& result
     return {};
 }
 
+StringAttributes noiseAttributes(const NoiseEstimate& e) {
+    if (!e.valid) return {};
+    return {{NoiseAttribute, str(e.relative())}, {NoiseRmseAttribute, str(e.rmse)}, {NoiseMeanAttribute, str(e.mean)}};
+}
+
 std::vector<ExrLayer> passLayers(const RenderResult& result) {
     std::vector<ExrLayer> layers;
-    for (const PassSums& p : result.passSums) {
-        ExrLayer l{str("pass", p.pass), {"R", "G", "B", "T"}, {}};
-        l.pixels.reserve(p.L.size() * 4);
-        for (size_t i = 0; i < p.L.size(); ++i) {
-            const Color c = p.L[i].rounded();
-            l.pixels.insert(l.pixels.end(), {c.x, c.y, c.z, float(p.T[i])});
+    // Each pass's sums, and those of its odd-index samples (the noise estimate).
+    for (const PassSums& p : result.passSums)
+        for (const bool odd : {false, true}) {
+            ExrLayer l{str("pass", p.pass, odd ? "odd" : ""), {"R", "G", "B", "T"}, {}};
+            l.pixels.reserve(p.L.size() * 4);
+            for (size_t i = 0; i < p.L.size(); ++i) {
+                const Color c = (odd ? p.oddL[i] : p.L[i]).rounded();
+                l.pixels.insert(l.pixels.end(), {c.x, c.y, c.z, float(odd ? p.oddT[i] : p.T[i])});
+            }
+            layers.push_back(std::move(l));
         }
-        layers.push_back(std::move(l));
-    }
     return layers;
 }
 
@@ -119,7 +128,9 @@ std::string describe(const PixelRect& r) {
 // its time, and the effective scene text (which records render.threads;
 // vdbmarch:renderHash stands for the rest of it).
 bool perTileAttribute(const std::string& name, bool timed, bool byPasses) {
-    static const std::set<std::string> always = {TileAttribute, "vdbmarch:renderSeconds", "vdbmarch:scene"};
+    static const std::set<std::string> always = {TileAttribute, "vdbmarch:renderSeconds", "vdbmarch:scene",
+                                                 NoiseAttribute, NoiseRmseAttribute, NoiseMeanAttribute,
+                                                 "vdbmarch:meanSpp"};
     // A tile given a time budget renders as many samples as fit; a part by
     // passes renders the samples of its passes.
     static const std::set<std::string> samples = {"vdbmarch:spp", "vdbmarch:photonPasses", PassSamplesAttribute};
@@ -138,6 +149,8 @@ StringAttributes mergedAttributes(const std::vector<Tile>& tiles, const std::map
         auto it = replaced.find(k);
         out.emplace_back(k, k == "vdbmarch:renderSeconds" ? str(seconds) : it != replaced.end() ? it->second : v);
     }
+    for (const auto& [k, v] : replaced)
+        if (!ref.attributes.count(k)) out.emplace_back(k, v);
     out.emplace_back("vdbmarch:mergedFrom", str(tiles.size(), " tiles (", ref.attribute(TileSplitAttribute), ")"));
     return out;
 }
@@ -185,33 +198,39 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
     PixelSums sums(pixels);
     for (int p = 0; p < total; ++p) {
         const Tile& t = *owner[size_t(p)];
-        const std::string name = str("pass", p);
-        const ExrLayer* layer = nullptr;
-        for (const ExrLayer& l : t.contents.layers)
-            if (l.name == name) layer = &l;
         int samples = 0;
         for (const auto& [q, k] : t.samples)
             if (q == p) samples = k;
-        if (!layer || layer->channels != std::vector<std::string>{"B", "G", "R", "T"} || samples <= 0)
-            throw InputError(str(t.path, ": damaged part: no layer ", name, " (B, G, R, T) or no sample count for it"));
         PassSums pass;
         pass.pass = p;
         pass.samples = samples;
-        pass.L.resize(pixels);
-        pass.T.resize(pixels);
-        // The file's channels are in name order: B, G, R, T.
-        for (size_t i = 0; i < pixels; ++i) {
-            const float* v = &layer->pixels[4 * i];
-            pass.L[i] = ColorSum(Color(v[2], v[1], v[0]));
-            pass.T[i] = v[3];
+        for (const bool odd : {false, true}) {
+            const std::string name = str("pass", p, odd ? "odd" : "");
+            const ExrLayer* layer = nullptr;
+            for (const ExrLayer& l : t.contents.layers)
+                if (l.name == name) layer = &l;
+            if (!layer || layer->channels != std::vector<std::string>{"B", "G", "R", "T"} || samples <= 0)
+                throw InputError(str(t.path, ": damaged part: no layer ", name, " (B, G, R, T) or no sample count for it"));
+            std::vector<ColorSum>& L = odd ? pass.oddL : pass.L;
+            std::vector<double>& T = odd ? pass.oddT : pass.T;
+            L.resize(pixels);
+            T.resize(pixels);
+            // The file's channels are in name order: B, G, R, T.
+            for (size_t i = 0; i < pixels; ++i) {
+                const float* v = &layer->pixels[4 * i];
+                L[i] = ColorSum(Color(v[2], v[1], v[0]));
+                T[i] = v[3];
+            }
         }
         sums.fold(pass);
     }
     MergedTiles out;
     out.frame.image = sums.average(frame.width(), frame.height());
     out.frame.window = {frame, frame};
-    out.frame.attributes = mergedAttributes(parts,
-                                            {{"vdbmarch:spp", str(sums.samples)}, {"vdbmarch:photonPasses", str(total)}});
+    std::map<std::string, std::string> replaced = {{"vdbmarch:spp", str(sums.samples)},
+                                                   {"vdbmarch:photonPasses", str(total)}};
+    for (auto& [k, v] : noiseAttributes(estimateNoise(sums))) replaced[k] = v;
+    out.frame.attributes = mergedAttributes(parts, replaced);
     return out;
 }
 
@@ -271,7 +290,9 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
     // Every tile against the first: the same split, frame, scene and
     // settings (any vdbmarch:* attribute but the per-tile ones).
     const Tile& ref = tiles.front();
-    const bool timed = ref.attribute("vdbmarch:timeBudget") != "none";
+    // A time budget or a noise target: tiles render as many samples as they need.
+    const bool timed = ref.attribute("vdbmarch:timeBudget") != "none" ||
+                       (ref.attributes.count(NoiseTargetAttribute) && ref.attribute(NoiseTargetAttribute) != "none");
     // The split and frame first, the named settings next, the hash of the
     // rest of the scene last, so the message names the most telling one.
     std::vector<std::string> keys = {TileSplitAttribute, "vdbmarch:frame"};
@@ -376,9 +397,24 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
     std::map<std::string, std::string> replaced;
     if (timed)
         for (const char* k : {"vdbmarch:spp", "vdbmarch:photonPasses"}) replaced[k] = valueRange(tiles, k);
+    // The frame's noise from the tiles': mean squared error and mean weighted by their pixels.
+    NoiseEstimate noise;
+    noise.valid = true;
+    double spp = 0;
+    for (const Tile& t : tiles) {
+        const double share = double(t.contents.image.pixelCount()) / double(framePixels);
+        noise.valid = noise.valid && t.attributes.count(NoiseRmseAttribute) && t.attributes.count(NoiseMeanAttribute);
+        const double rmse = std::atof(t.attribute(NoiseRmseAttribute).c_str());
+        noise.rmse += share * rmse * rmse;
+        noise.mean += share * std::atof(t.attribute(NoiseMeanAttribute).c_str());
+        spp += share * std::atof(t.attribute("vdbmarch:meanSpp").c_str());
+    }
+    noise.rmse = std::sqrt(noise.rmse);
+    for (auto& [k, v] : noiseAttributes(noise)) replaced[k] = v;
+    if (ref.attributes.count("vdbmarch:meanSpp")) replaced["vdbmarch:meanSpp"] = str(spp);
     m.attributes = mergedAttributes(tiles, replaced);
     if (timed && valueRange(tiles, "vdbmarch:spp").find('-') != std::string::npos)
-        out.warnings.push_back(str("the tiles were rendered with a time budget and reached ", valueRange(tiles, "vdbmarch:spp"),
+        out.warnings.push_back(str("the tiles were rendered with a time budget or a noise target and reached ", valueRange(tiles, "vdbmarch:spp"),
                                    " samples per pixel: noise (and, with photons, bias) may differ between tiles"));
     return out;
 }

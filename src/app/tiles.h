@@ -22,6 +22,15 @@ inline constexpr const char* PassSamplesAttribute = "vdbmarch:passSamples";  // 
 // Hash of everything that decides the pixels: the effective scene without
 // render.threads (which never changes a pixel), the version and the cache.
 inline constexpr const char* RenderHashAttribute = "vdbmarch:renderHash";
+// The noise estimate from the two halves (render/render.h NoiseEstimate):
+// its relative value, RMSE and mean, which merge combines over tiles.
+inline constexpr const char* NoiseAttribute = "vdbmarch:noiseEstimate";
+inline constexpr const char* NoiseRmseAttribute = "vdbmarch:noiseRmse";
+inline constexpr const char* NoiseMeanAttribute = "vdbmarch:noiseMean";
+inline constexpr const char* NoiseTargetAttribute = "vdbmarch:noiseTarget";  // render.noise, or "none"
+
+// The three noise attributes of an estimate (none when it is not valid).
+StringAttributes noiseAttributes(const NoiseEstimate& e);
 
 // What part of the frame a render covers: the whole frame, a tile of a
 // fixed split, or a crop.

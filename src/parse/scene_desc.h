@@ -110,6 +110,13 @@ struct RenderSettings {
     bool productSampling = false;  // measured slower to converge on cloud_sun and exp1_sphere (BENCHMARKS.md)
     AovSet aovs;  // none by default: the EXR holds RGBA only
     VolumeSampling volumeSampling = VolumeSampling::Mis;
+    // Noise target (render --noise): > 0 stops the render once the
+    // estimated RMSE over the image's mean is below it, sampling only the
+    // blocks of pixels still above it (adaptive sampling, docs/noise.md).
+    float noise = 0;
+    // The denoiser (docs/denoise.md): Preview denoises the PNG only; On also
+    // the EXR's RGBA (the noisy beauty kept as a layer).
+    enum class Denoise { Off, Preview, On } denoise = Denoise::Preview;
 };
 
 // The volume photon map (scene key "photons").

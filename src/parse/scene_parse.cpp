@@ -316,7 +316,7 @@ AovSet parseAovs(const JsonReader& r) {
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
                  "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "aovs",
-                 "volume_sampling"});
+                 "volume_sampling", "noise", "denoise"});
     RenderSettings s;
     {
         std::vector<std::string> names = {"auto"};
@@ -348,6 +348,12 @@ RenderSettings parseRender(const JsonReader& r) {
         const std::string v = r.choice("volume_sampling", "mis", {"mis", "distance", "equiangular"});
         s.volumeSampling = v == "distance" ? VolumeSampling::Distance
                            : v == "equiangular" ? VolumeSampling::Equiangular : VolumeSampling::Mis;
+    }
+    if (r.has("noise")) s.noise = float(r.numberIn("noise", 0, 1e-4, 10));
+    {
+        const std::string v = r.choice("denoise", "preview", {"preview", "on", "off"});
+        s.denoise = v == "on" ? RenderSettings::Denoise::On
+                    : v == "off" ? RenderSettings::Denoise::Off : RenderSettings::Denoise::Preview;
     }
     return s;
 }

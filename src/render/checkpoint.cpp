@@ -15,7 +15,7 @@ namespace vdbmarch {
 
 namespace {
 
-constexpr int CheckpointFormat = 1;
+constexpr int CheckpointFormat = 2;
 const char* const Magic = "vdbmarch checkpoint ";
 
 // FNV-1a over 64-bit words (the last partial word zero-padded): a checksum
@@ -73,6 +73,8 @@ public:
     void pass(const PassSums& p) {
         array(p.L);
         array(p.T);
+        array(p.oddL);
+        array(p.oddT);
     }
     void finish() {
         const uint64_t h = mHash.value();
@@ -105,6 +107,8 @@ public:
         const size_t n = h.at("pixels").get<size_t>();
         array(p.L, n);
         array(p.T, n);
+        array(p.oddL, n);
+        array(p.oddT, n);
     }
     bool done() const { return mAt == mSize; }
 
@@ -130,6 +134,7 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
           k.marchedLength, k.skippedLength}},
         {"pixels", c.sums.L.size()},
         {"sums_samples", c.sums.samples},
+        {"converged", c.sums.convergedAt.size()},
         {"open", passHeader(c.open)},
         {"aovs",
          {{"depth", c.aovs.depth.size()},
@@ -148,6 +153,9 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
         w.bytes(head.data(), head.size());
         w.array(c.sums.L);
         w.array(c.sums.T);
+        w.array(c.sums.oddL);
+        w.array(c.sums.oddT);
+        w.array(c.sums.convergedAt);
         w.pass(c.open);
         for (const PassSums& p : c.passSums) w.pass(p);
         w.array(c.aovs.depth);
@@ -211,6 +219,9 @@ RenderCheckpoint readCheckpointFile(const std::string& path, const CheckpointIde
         const size_t pixels = h.at("pixels").get<size_t>();
         read.array(c.sums.L, pixels);
         read.array(c.sums.T, pixels);
+        read.array(c.sums.oddL, pixels);
+        read.array(c.sums.oddT, pixels);
+        read.array(c.sums.convergedAt, h.at("converged").get<size_t>());
         c.sums.samples = h.at("sums_samples").get<int>();
         read.pass(c.open, h.at("open"));
         for (const auto& p : h.at("passes")) {

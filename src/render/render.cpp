@@ -1,7 +1,9 @@
 #include "render/render.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 
@@ -74,16 +76,31 @@ uint64_t AovSums::bytesPerPixel(const AovSet& a) {
 
 namespace {
 
+// Adaptive sampling: pixels stop in blocks of NoiseBlock x NoiseBlock of
+// the window, decided at 16 samples and then every quarter more.
+constexpr int NoiseBlock = 8;
+int nextNoiseCheck(int n) {
+    int c = 16;
+    while (c <= n) c = std::max(c + 4, (c * 5 + 3) / 4);
+    return c;
+}
+bool isNoiseCheck(int n) {
+    int c = 16;
+    while (c < n) c = std::max(c + 4, (c * 5 + 3) / 4);
+    return c == n;
+}
+
 // Random stream of the feature AOVs, apart from the beauty's.
 constexpr uint64_t AovStream = 0x616f7673;
 
 // The layers of the requested AOVs from their sums over `spp` samples. The
 // indirect layer is the beauty minus the direct one, so they add up to the
 // beauty exactly up to the rounding of that subtraction.
-std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const std::vector<Color>& beauty, int spp) {
+std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const PixelSums& sums) {
     std::vector<ExrLayer> layers;
+    const std::vector<Color>& beauty = sums.L;
     const size_t pixels = beauty.size();
-    const float inv = 1.f / float(spp);
+    auto inv = [&](size_t p) { return 1.f / float(sums.samplesOf(p)); };
     auto colorLayer = [&](const char* name, std::vector<std::string> channels, auto value) {
         ExrLayer l{name, std::move(channels), {}};
         l.pixels.reserve(3 * pixels);
@@ -99,11 +116,11 @@ std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const std:
             l.pixels[p] = s.depthSamples[p] > 0 ? float(s.depth[p] / double(s.depthSamples[p])) : NoDepth;
         layers.push_back(std::move(l));
     }
-    if (aovs.albedo) colorLayer("albedo", {"R", "G", "B"}, [&](size_t p) { return s.albedo[p] * inv; });
-    if (aovs.normal) colorLayer("normal", {"X", "Y", "Z"}, [&](size_t p) { return s.normal[p] * inv; });
-    if (aovs.direct) colorLayer("direct", {"R", "G", "B"}, [&](size_t p) { return s.direct[p] * inv; });
+    if (aovs.albedo) colorLayer("albedo", {"R", "G", "B"}, [&](size_t p) { return s.albedo[p] * inv(p); });
+    if (aovs.normal) colorLayer("normal", {"X", "Y", "Z"}, [&](size_t p) { return s.normal[p] * inv(p); });
+    if (aovs.direct) colorLayer("direct", {"R", "G", "B"}, [&](size_t p) { return s.direct[p] * inv(p); });
     if (aovs.indirect)
-        colorLayer("indirect", {"R", "G", "B"}, [&](size_t p) { return beauty[p] * inv - s.direct[p] * inv; });
+        colorLayer("indirect", {"R", "G", "B"}, [&](size_t p) { return beauty[p] * inv(p) - s.direct[p] * inv(p); });
     return layers;
 }
 
@@ -113,19 +130,79 @@ void PixelSums::fold(const PassSums& pass) {
     for (size_t i = 0; i < L.size(); ++i) {
         L[i] += pass.L[i].rounded();
         T[i] += double(float(pass.T[i]));
+        oddL[i] += pass.oddL[i].rounded();
+        oddT[i] += double(float(pass.oddT[i]));
     }
     samples += pass.samples;
 }
 
 Image PixelSums::average(int width, int height) const {
     Image img(width, height);
-    const float inv = 1.f / float(samples);
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
             const size_t p = size_t(y) * size_t(width) + size_t(x);
+            const float inv = 1.f / float(samplesOf(p));
             img.set(x, y, L[p] * inv, clamp(1.f - float(T[p]) * inv, 0.f, 1.f));
         }
     return img;
+}
+
+namespace {
+
+// Samples of [first, first + n) with even and with odd index.
+void halfCounts(int first, int n, int& even, int& odd) {
+    odd = (first + n) / 2 - first / 2;
+    even = n - odd;
+}
+
+// One half's mean image: the odd-index samples' sums, or the total minus them.
+Image halfImage(const PixelSums& s, int width, int height, bool odd) {
+    Image img(width, height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const size_t p = size_t(y) * size_t(width) + size_t(x);
+            int ne, no;
+            halfCounts(0, s.samplesOf(p), ne, no);
+            const int n = odd ? no : ne;
+            if (n == 0) continue;
+            const Color l = odd ? s.oddL[p] : s.L[p] - s.oddL[p];
+            const double t = odd ? s.oddT[p] : s.T[p] - s.oddT[p];
+            img.set(x, y, l / float(n), clamp(1.f - float(t / double(n)), 0.f, 1.f));
+        }
+    return img;
+}
+
+// Mean and variance of the mean of one pixel from its sums over n samples
+// starting at sample `first` (the two halves' difference, NoiseEstimate).
+bool pixelNoise(const Color& L, const Color& oddL, int first, int n, Color& mean, Color& variance) {
+    int ne, no;
+    halfCounts(first, n, ne, no);
+    if (ne == 0 || no == 0) return false;
+    mean = L / float(n);
+    const Color d = (L - oddL) / float(ne) - oddL / float(no);
+    variance = d * d * float(double(ne) * double(no) / (double(n) * double(n)));
+    return true;
+}
+
+}  // namespace
+
+Image PixelSums::evenHalf(int width, int height) const { return halfImage(*this, width, height, false); }
+Image PixelSums::oddHalf(int width, int height) const { return halfImage(*this, width, height, true); }
+
+NoiseEstimate estimateNoise(const PixelSums& sums) {
+    NoiseEstimate e;
+    double sumVar = 0, sumMean = 0;
+    for (size_t p = 0; p < sums.L.size(); ++p) {
+        Color mean, var;
+        if (!pixelNoise(sums.L[p], sums.oddL[p], 0, sums.samplesOf(p), mean, var)) return e;
+        sumVar += double(var.x) + double(var.y) + double(var.z);
+        sumMean += double(mean.x) + double(mean.y) + double(mean.z);
+    }
+    const double n = 3.0 * double(std::max<size_t>(1, sums.L.size()));
+    e.valid = !sums.L.empty();
+    e.rmse = std::sqrt(sumVar / n);
+    e.mean = sumMean / n;
+    return e;
 }
 
 PixelRect tileOfFrame(int index, int count, int width, int height) {
@@ -140,7 +217,9 @@ PixelRect tileOfFrame(int index, int count, int width, int height) {
 
 void checkImageMemory(int width, int height, const AovSet& aovs) {
     // The totals, the open pass's sums, the RGBA result and the AOVs.
-    const uint64_t perPixel = sizeof(Color) + sizeof(ColorSum) + 2 * sizeof(double) + 4 * sizeof(float) + AovSums::bytesPerPixel(aovs);
+    // Each twice: all samples and the odd-index half.
+    const uint64_t perPixel = 2 * (sizeof(Color) + sizeof(ColorSum) + 2 * sizeof(double)) + 4 * sizeof(float) +
+                              sizeof(int) + AovSums::bytesPerPixel(aovs);
     checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
@@ -171,6 +250,9 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     if (options.passes) {
         const auto [a, b] = *options.passes;
         if (timed) throw InputError("--passes and --time: a part of a render by passes renders fixed samples");
+        if (rs.noise > 0)
+            throw InputError(str("--passes and render.noise = ", rs.noise, ": a part of a render by passes renders "
+                                 "fixed samples; split a render to a noise target by tiles instead"));
         if (aovs.any())
             throw InputError(str("--passes ", a, "-", b, " and render.aovs: AOVs are not split by passes; split the "
                                  "render by tiles instead"));
@@ -198,8 +280,11 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     PassSums open;  // the sums of the pass being rendered
     open.pass = -1;
     AovSums aovSums(aovs, pixels);
+    // Adaptive sampling towards the noise target (render.noise).
+    const bool adaptive = rs.noise > 0;
+    if (adaptive) sums.convergedAt.assign(pixels, 0);
     std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
-    ProgressBar progress(options.progress, timed ? 1000 : tiles);
+    ProgressBar progress(options.progress, timed || options.checkpoint || rs.noise > 0 ? 1000 : tiles);
     const int threads = resolveThreadCount(rs.threads);
     result.threads = threads;
     auto start = std::chrono::steady_clock::now();
@@ -252,6 +337,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                         for (int x = x0; x < std::min(x0 + TileSize, window.x1); ++x) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
+                            if (adaptive && sums.convergedAt[local] > 0) continue;  // met the noise target
                             ColorSum& sum = open.L[local];
                             double& transmittance = open.T[local];
                             for (int s = s0; s < s1; ++s) {
@@ -269,6 +355,10 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                                 }
                                 sum.add(pr.L);
                                 transmittance += pr.transmittance;
+                                if (s & 1) {
+                                    open.oddL[local].add(pr.L);
+                                    open.oddT[local] += pr.transmittance;
+                                }
                                 if (aovs.any()) {
                                     if (aovs.splitDirect()) aovSums.direct[local] += pr.direct;
                                     if (aovs.firstEvent()) {
@@ -285,7 +375,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                             }
                         }
                     tileCounters[size_t(tile)] += ctx.counters;
-                    if (!timed && !hooks) progress.tick();
+                    if (!timed && !hooks && !adaptive) progress.tick();
                 }
             }, tbb::simple_partitioner());
         });
@@ -306,6 +396,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             open.pass = pass;
             open.L.assign(pixels, ColorSum());
             open.T.assign(pixels, 0.0);
+            open.oddL.assign(pixels, ColorSum());
+            open.oddT.assign(pixels, 0.0);
         }
         open.samples += samples;
     };
@@ -373,27 +465,83 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         return stop;
     };
 
+    // The noise target (render.noise, docs/noise.md): at fixed sample
+    // counts (isNoiseCheck) the two halves give every pixel's variance; the
+    // render stops once the window's RMSE is below noise x its mean. Until
+    // then each 8x8 block of pixels gets samples in proportion to its
+    // per-sample standard deviation s_b, the allocation that minimises the
+    // image's MSE for a sample count (n_b = k s_b gives MSE = mean(s_b) / k),
+    // with k set so that this MSE meets the target: a block stops once
+    // n >= k s_b. The decisions depend only on the sums, so the image is the
+    // same for any thread count.
+    bool reachedTarget = false;
+    auto checkNoise = [&](int n) {
+        if (!adaptive || !isNoiseCheck(n)) return false;
+        std::vector<float> perSample(pixels);  // variance of one sample, RGB summed
+        double sumVar = 0, sumMean = 0;
+        for (size_t p = 0; p < pixels; ++p) {
+            Color L = sums.L[p], odd = sums.oddL[p], mean, var;
+            if (open.pass >= 0) {
+                L += open.L[p].rounded();
+                odd += open.oddL[p].rounded();
+            }
+            const int k = sums.convergedAt[p] > 0 ? sums.convergedAt[p] : n;
+            if (!pixelNoise(L, odd, 0, k, mean, var)) return false;
+            const double v = double(var.x) + double(var.y) + double(var.z);
+            perSample[p] = float(v * k);
+            sumVar += v;
+            sumMean += double(mean.x) + double(mean.y) + double(mean.z);
+        }
+        const double target = double(rs.noise) * sumMean / double(3 * pixels);
+        if (std::sqrt(sumVar / double(3 * pixels)) <= target) return reachedTarget = true;
+        // s_b per block, and k from their pixel-weighted mean.
+        const int bx = (ww + NoiseBlock - 1) / NoiseBlock, by = (wh + NoiseBlock - 1) / NoiseBlock;
+        std::vector<double> sigma(size_t(bx) * size_t(by), 0.0);
+        std::vector<int> count(sigma.size(), 0);
+        for (int y = 0; y < wh; ++y)
+            for (int x = 0; x < ww; ++x) {
+                const size_t b = size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock);
+                sigma[b] += perSample[size_t(y) * size_t(ww) + size_t(x)];
+                ++count[b];
+            }
+        double weighted = 0;
+        for (size_t b = 0; b < sigma.size(); ++b) {
+            sigma[b] = std::sqrt(sigma[b] / (3.0 * count[b]));
+            weighted += sigma[b] * count[b];
+        }
+        const double k = weighted / double(pixels) / (target * target);
+        for (int y = 0; y < wh; ++y)
+            for (int x = 0; x < ww; ++x) {
+                int& c = sums.convergedAt[size_t(y) * size_t(ww) + size_t(x)];
+                if (c == 0 && double(n) >= k * sigma[size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock)]) c = n;
+            }
+        return false;
+    };
+
     int spp = resumeSample - first;
-    if (!timed && !hooks) {
+    if (!timed && !hooks && !adaptive) {
         renderSamples(first, last);
         spp = last - first;
     } else if (!timed) {
         // In chunks of whole samples per pixel, about a second each, so a
-        // stop is acted on soon; the sums do not depend on the chunks.
-        int s = resumeSample, chunk = 1;
+        // stop is acted on soon, and ending at every noise check; the sums
+        // do not depend on the chunks.
+        int s = resumeSample, chunk = hooks ? 1 : last;
         while (s < last) {
             if (checkpointAt(s)) {
                 result.interrupted = true;
                 break;
             }
             const auto c0 = std::chrono::steady_clock::now();
-            const int e = std::min(last, s + chunk);
+            const int e = std::min({last, s + chunk, adaptive ? nextNoiseCheck(s) : last});
             renderSamples(s, e);
             const double perSample =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count() / double(e - s);
-            chunk = int(std::clamp(std::min(1.0, hooks->everySeconds) / std::max(perSample, 1e-6), 1.0, 4096.0));
+            if (hooks)
+                chunk = int(std::clamp(std::min(1.0, hooks->everySeconds) / std::max(perSample, 1e-6), 1.0, 4096.0));
             s = e;
             progress.set(double(s - first) / double(last - first));
+            if (checkNoise(s)) break;
         }
         spp = s - first;
     } else {
@@ -416,6 +564,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             lastPass = std::chrono::duration<double>(now - p0).count() - (illumination->stats.seconds - photonsBefore);
             double elapsed = std::chrono::duration<double>(now - runStart).count();
             progress.set(elapsed / options.timeBudget);
+            if (checkNoise(spp)) break;
             const int next = photonPasses.passOf(spp);
             const double nextPhotons =
                 next != illumination->pass && photonPasses.needsWork(next) ? firstIlluminationSeconds : 0.0;
@@ -433,7 +582,22 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     result.photonPasses = illumination->pass + 1;
     closePass();
     result.image = sums.average(ww, wh);
-    result.layers = aovLayers(aovs, aovSums, sums.L, spp);
+    result.layers = aovLayers(aovs, aovSums, sums);
+    result.noise = estimateNoise(sums);
+    result.reachedNoiseTarget = reachedTarget;
+    double sampled = 0;
+    for (size_t p = 0; p < pixels; ++p) sampled += sums.samplesOf(p);
+    result.meanSpp = sampled / double(pixels);
+    if (adaptive) {
+        // How the samples were spent (docs/noise.md).
+        ExrLayer count{"samples", {"N"}, std::vector<float>(pixels)};
+        for (size_t p = 0; p < pixels; ++p) count.pixels[p] = float(sums.samplesOf(p));
+        result.layers.push_back(std::move(count));
+    }
+    if (options.keepHalves) {
+        result.evenHalf = sums.evenHalf(ww, wh);
+        result.oddHalf = sums.oddHalf(ww, wh);
+    }
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() + resumedSeconds;
     result.counters = counters();
     return result;

@@ -50,6 +50,8 @@ struct RenderOptions {
     // The result keeps each pass's sums (RenderResult::passSums) for merge.
     std::optional<std::pair<int, int>> passes;
     std::optional<CheckpointHooks> checkpoint;
+    // Keep the two half renders in the result (the denoiser's input).
+    bool keepHalves = false;
 };
 
 // An RGB sum in double: thousands of samples add up without the float
@@ -74,6 +76,10 @@ struct PassSums {
     int samples = 0;
     std::vector<ColorSum> L;
     std::vector<double> T;
+    // The same sums over the odd-index samples only: with the totals they
+    // give two independent half renders (the noise estimate, the denoiser).
+    std::vector<ColorSum> oddL;
+    std::vector<double> oddT;
 };
 
 // A render's per-pixel totals. Samples are summed per photon pass and the
@@ -83,12 +89,35 @@ struct PassSums {
 struct PixelSums {
     std::vector<Color> L;
     std::vector<double> T;
+    std::vector<Color> oddL;  // over the odd-index samples (PassSums::oddL)
+    std::vector<double> oddT;
     int samples = 0;
-    explicit PixelSums(size_t pixels) : L(pixels, Color(0)), T(pixels, 0.0) {}
+    // Adaptive sampling (render.noise): the samples a pixel had when it
+    // stopped receiving more; 0 while it still samples (or without it).
+    std::vector<int> convergedAt;
+    explicit PixelSums(size_t pixels) : L(pixels, Color(0)), T(pixels, 0.0), oddL(pixels, Color(0)), oddT(pixels, 0.0) {}
     void fold(const PassSums& pass);
+    // Samples in pixel p's sums.
+    int samplesOf(size_t p) const { return convergedAt.empty() || convergedAt[p] == 0 ? samples : convergedAt[p]; }
     // RGB = L / samples, alpha = 1 - T / samples.
     Image average(int width, int height) const;
+    // The means of the even-index and of the odd-index samples (RGBA), two
+    // independent estimates of each pixel.
+    Image evenHalf(int width, int height) const;
+    Image oddHalf(int width, int height) const;
 };
+
+// The noise of a render estimated from its two halves, without a
+// reference: per pixel the variance of the mean is (m_even - m_odd)^2
+// n_even n_odd / n^2, and rmse is its root mean over pixels and RGB, the
+// figure `vdbmarch compare` prints against the truth (docs/noise.md).
+struct NoiseEstimate {
+    bool valid = false;  // at least 2 samples per pixel
+    double rmse = 0;     // estimated RMSE of the RGB against the converged image
+    double mean = 0;     // mean of the RGB
+    double relative() const { return mean > 0 ? rmse / mean : 0.0; }
+};
+NoiseEstimate estimateNoise(const PixelSums& sums);
 
 // The AOVs' per-pixel sums (only those render.aovs asks for are allocated).
 struct AovSums {
@@ -123,7 +152,12 @@ struct RenderResult {
     double illuminationSeconds = 0;  // photon tracing and cache (part of seconds)
     size_t photons = 0, cacheCells = 0;
     int threads = 0;      // worker threads used
-    int spp = 0;          // samples per pixel actually rendered
+    int spp = 0;          // samples per pixel actually rendered (the most any pixel got)
+    double meanSpp = 0;   // averaged over the pixels (below spp with adaptive sampling)
+    NoiseEstimate noise;  // of the beauty, from its two halves
+    // Whether the render stopped because the noise target was met.
+    bool reachedNoiseTarget = false;
+    Image evenHalf, oddHalf;  // the two half renders (RenderOptions::keepHalves)
     int photonPasses = 1; // progressive photon passes used (illumination/illumination.h)
     // The AOVs render.aovs asks for, as EXR layers (docs/aovs.md), in the
     // order depth, albedo, normal, direct, indirect.

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 
 #include "image/exr_io.h"
 #include "support/support.h"
@@ -200,15 +201,20 @@ TEST_F(TilesCli, PartsByPhotonPassesMergeBitIdentically) {
     renderGlass("b.exr", {"--passes", "1-4", "--threads", "2"});  // crosses the refinements at passes 1 and 3
     renderGlass("c.exr", {"--passes", "4-5", "--threads", "1"});  // starts after both: makes them itself
     const ExrContents c = readExrContents(work("c.exr"));
-    ASSERT_EQ(c.layers.size(), 1u);
+    // The pass's sums, and those of its odd-index samples (the noise estimate).
+    ASSERT_EQ(c.layers.size(), 2u);
     EXPECT_EQ(c.layers[0].name, "pass4");
+    EXPECT_EQ(c.layers[1].name, "pass4odd");
     ASSERT_EQ(merge({"c.exr", "a.exr", "b.exr"}).exitCode, 0);
     const CliResult same = identical("merged.exr", "single.exr");
     EXPECT_EQ(same.exitCode, 0) << same.out;
-    std::string spp;
-    for (const auto& [k, v] : readExrStringAttributes(work("merged.exr")))
-        if (k == "vdbmarch:spp") spp = v;
-    EXPECT_EQ(spp, "9");
+    std::map<std::string, std::string> merged, single;
+    for (const auto& [k, v] : readExrStringAttributes(work("merged.exr"))) merged[k] = v;
+    for (const auto& [k, v] : readExrStringAttributes(work("single.exr"))) single[k] = v;
+    EXPECT_EQ(merged["vdbmarch:spp"], "9");
+    // The same sums in the same order: the same noise estimate.
+    ASSERT_TRUE(single.count("vdbmarch:noiseEstimate"));
+    EXPECT_EQ(merged["vdbmarch:noiseEstimate"], single["vdbmarch:noiseEstimate"]);
     expectCliError(merge({"a.exr", "c.exr"}), {"3 of 5 photon passes missing: 1, 2, 3", "nothing written"});
     renderGlass("b2.exr", {"--passes", "0-2"});
     expectCliError(merge({"a.exr", "b2.exr", "c.exr"}), {"a.exr and b2.exr both hold photon pass 0"});
