@@ -68,6 +68,19 @@ void expectSameRender(const RenderResult& a, const RenderResult& b, const std::s
     EXPECT_EQ(a.counters.cameraRays, b.counters.cameraRays) << what;
 }
 
+// A render to a noise target: which pixels stopped is part of the state.
+TEST(Checkpoint, NoiseTargetResumesBitIdentically) {
+    TempDir dir("checkpoint_noise");
+    const auto scene = smallScene(Method::Reference, {"render.noise=0.08", "render.spp=400"});
+    const RenderResult whole = renderImage(*scene);
+    ASSERT_TRUE(whole.reachedNoiseTarget);
+    ASSERT_LT(whole.meanSpp, double(whole.spp));  // some pixels stopped early
+    for (int stopAt : {3, whole.spp - 2}) {
+        const RenderCheckpoint state = interrupted(*scene, {}, stopAt, dir / "noise.ckpt");
+        expectSameRender(whole, resumed(*scene, {}, state), str("noise target, stopped at ", stopAt));
+    }
+}
+
 class CheckpointMethods : public ::testing::TestWithParam<Method> {};
 
 TEST_P(CheckpointMethods, ResumedRenderIsBitIdentical) {
