@@ -506,7 +506,8 @@ void prefilterFeatures(std::vector<Feature>& features, const DenoiseOptions& o, 
         for (int y = tile.y0; y < tile.y1; ++y)
             for (int x = tile.x0; x < tile.x1; ++x) {
                 const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
-                for (int c = 0; c < channels; ++c) filtered[size_t(c)].at(x, y) = sum[size_t(c) * size_t(n) + i] / weights[i];
+                for (int c = 0; c < channels; ++c)
+                    filtered[size_t(c)].at(x, y) = sum[size_t(c) * size_t(n) + i] / weights[i];
                 varianceFactor.at(x, y) = squares[i] / (weights[i] * weights[i]);
             }
     });
@@ -645,10 +646,13 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
     arena.execute([&] {
         // Colour and alpha of both halves, and the variance of one half.
         const int channels = hasAlpha ? 4 : 3;
-        std::vector<Plane> a(static_cast<size_t>(channels)), b(static_cast<size_t>(channels)), variance(static_cast<size_t>(channels));
+        const size_t planes = static_cast<size_t>(channels);
+        std::vector<Plane> a(planes), b(planes), variance(planes);
         for (int c = 0; c < channels; ++c) {
-            if (c < 3) loadHalves(channelOf(in.halfA, c), channelOf(in.halfB, c), w, h, pad, a[size_t(c)], b[size_t(c)]);
-            else loadHalves(in.alphaA, in.alphaB, w, h, pad, a[3], b[3]);
+            if (c < 3)
+                loadHalves(channelOf(in.halfA, c), channelOf(in.halfB, c), w, h, pad, a[size_t(c)], b[size_t(c)]);
+            else
+                loadHalves(in.alphaA, in.alphaB, w, h, pad, a[3], b[3]);
             variance[size_t(c)] = halfVariance(a[size_t(c)], b[size_t(c)], options.varianceRadius);
         }
 
@@ -664,8 +668,11 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                 }
                 features.push_back(std::move(f));
             };
-            if (!in.albedo.empty()) add({channelOf(in.albedo, 0), channelOf(in.albedo, 1), channelOf(in.albedo, 2)}, 0.f);
-            if (!in.normal.empty()) add({channelOf(in.normal, 0), channelOf(in.normal, 1), channelOf(in.normal, 2)}, 0.f);
+            auto channels3 = [](const std::vector<Color>& v) {
+                return std::vector<std::vector<float>>{channelOf(v, 0), channelOf(v, 1), channelOf(v, 2)};
+            };
+            if (!in.albedo.empty()) add(channels3(in.albedo), 0.f);
+            if (!in.normal.empty()) add(channels3(in.normal), 0.f);
             if (!in.depth.empty()) {
                 std::vector<float> depth = normalisedDepth(in.depth);
                 if (!depth.empty()) add({depth}, 1.f);
@@ -694,9 +701,10 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
 
         forEachTile(w, h, [&](const Rect& tile) {
             const int tw = tile.width(), n = tw * tile.height();
+            const size_t tilePixels = static_cast<size_t>(n), tileRow = static_cast<size_t>(tw);
             BoxScratch scratch(TileSize, f);
-            std::vector<float> distanceA(static_cast<size_t>(n)), distanceB(static_cast<size_t>(n)), featureDistance(static_cast<size_t>(tw)),
-                featureScratch(static_cast<size_t>(tw)), weightA(static_cast<size_t>(tw)), weightB(static_cast<size_t>(tw));
+            std::vector<float> distanceA(tilePixels), distanceB(tilePixels), featureDistance(tileRow),
+                featureScratch(tileRow), weightA(tileRow), weightB(tileRow);
             // Sums of w * value per channel (A filtered with B's weights, and
             // B with A's), then the sums of the weights.
             std::vector<float> sumA(size_t(channels) * size_t(n), 0.f), sumB(size_t(channels) * size_t(n), 0.f),
@@ -738,8 +746,8 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                     }
                 }
 
-            // The centre weight is 1 (its distances are <= 0), so the sums of
-            // the weights are >= 1.
+            // The centre weight is 1 (its distances are <= 0; to the rounding
+            // of the running sums), so the sums of the weights are about >= 1.
             for (int y = tile.y0; y < tile.y1; ++y)
                 for (int x = tile.x0; x < tile.x1; ++x) {
                     const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
