@@ -5,6 +5,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include <cmath>
 #include <map>
 #include <memory>
 #include <string>
@@ -14,6 +15,7 @@
 #include "cache/sh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "denoise/denoise.h"
 #include "illumination/illumination.h"
 #include "transport/media_point.h"
 #include "transport/roulette.h"
@@ -441,6 +443,51 @@ BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_photons_rs4, "photons", 4)->Un
 BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_photons_rs1, "photons", 1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, li_cache_rs4, "cache", 4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_TransmittanceMarchSample, walk_only, "photons", 4, true)->Unit(benchmark::kMillisecond);
+
+// Denoising a 640x480 frame (src/denoise/): two noisy half renders (a soft
+// gradient with discs of sharp edges, Gaussian noise of sigma 0.15 per half),
+// alpha and the three features (albedo, normal, depth) with noise of their
+// own. The argument is the thread count; real time, since the work is
+// spread over a task arena.
+const DenoiseInput& denoiseBenchInput() {
+    static const DenoiseInput input = [] {
+        DenoiseInput in;
+        in.width = 640;
+        in.height = 480;
+        Rng rng(11);
+        auto gaussian = [&] {
+            const float u1 = 1.f - rng.uniform(), u2 = rng.uniform();
+            return std::sqrt(-2.f * std::log(u1)) * std::cos(2.f * Pi * u2);
+        };
+        auto noise = [&](float sigma) { return sigma * Vec3(gaussian(), gaussian(), gaussian()); };
+        for (int y = 0; y < in.height; ++y)
+            for (int x = 0; x < in.width; ++x) {
+                const float u = x / 640.f, v = y / 480.f;
+                const bool disc = std::hypot(x - 200.f, y - 240.f) < 120.f || std::hypot(x - 470.f, y - 200.f) < 80.f;
+                const Color c = disc ? Color(0.9f - 0.2f * u, 0.7f, 0.4f + 0.2f * v)
+                                     : Color(0.2f + 0.3f * u, 0.25f + 0.2f * v, 0.3f + 0.1f * (u + v));
+                const float alpha = disc ? 1.f : 0.5f + 0.3f * u;
+                in.halfA.push_back(c + noise(0.15f));
+                in.halfB.push_back(c + noise(0.15f));
+                in.alphaA.push_back(alpha + 0.1f * gaussian());
+                in.alphaB.push_back(alpha + 0.1f * gaussian());
+                in.albedo.push_back((disc ? Color(0.8f, 0.6f, 0.5f) : Color(0.3f)) + noise(0.05f));
+                in.normal.push_back((disc ? Vec3(0, 0, 1) : Vec3(0, 1, 0)) + noise(0.1f));
+                in.depth.push_back((disc ? 5.f : 12.f) + 0.2f * gaussian());
+            }
+        return in;
+    }();
+    return input;
+}
+
+void BM_Denoise640x480(benchmark::State& state) {
+    const DenoiseInput& in = denoiseBenchInput();
+    DenoiseOptions options;
+    options.threads = int(state.range(0));
+    for (auto _ : state) benchmark::DoNotOptimize(denoise(in, options));
+    state.SetItemsProcessed(int64_t(state.iterations()) * in.width * in.height);
+}
+BENCHMARK(BM_Denoise640x480)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

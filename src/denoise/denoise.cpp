@@ -1,0 +1,768 @@
+#include "denoise/denoise.h"
+
+#include "core/error.h"
+#include "core/threads.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+namespace vdbmarch {
+
+namespace {
+
+// Output tiles of the NL-means passes. Fixed (not derived from the thread
+// count) so that the running sums start at the same pixels and the result is
+// bit-identical for any number of threads.
+constexpr int TileSize = 64;
+// Keeps the distance finite where both variances are 0 (noise-free input):
+// there only (nearly) identical values are averaged.
+constexpr float DistanceEpsilon = 1e-10f;
+// A pixel distance this large already makes the weight of any patch that
+// holds it negligible (1e4 / 49 > 87 for a 7x7 patch of one channel); the
+// clamp keeps the running sums of the box filter precise.
+constexpr float DistanceClamp = 1e4f;
+// Finite inputs are clamped to this magnitude so that no square, sum or
+// product below overflows (4e30 squared differences, sums of a few thousand).
+constexpr float ColorLimit = 1e15f;
+constexpr float FeatureLimit = 1e3f;
+// Depth at or beyond this is "nothing met" (the renderer writes 1e10).
+constexpr float FarDepth = 1e9f;
+// E[median of the 8 squared differences to the neighbours] / sigma^2 for
+// i.i.d. Gaussian noise: 1.407, measured over 2e5 simulated pixels.
+constexpr float MedianSquaredDifferenceScale = 1.407f;
+
+// ---------------------------------------------------------------------------
+// A float plane with `pad` replicated pixels on every side, so that patch
+// reads near the border need no clamping in the inner loops.
+struct Plane {
+    int width = 0, height = 0, pad = 0, stride = 0;
+    std::vector<float> data;
+
+    Plane() = default;
+    Plane(int w, int h, int p) : width(w), height(h), pad(p), stride(w + 2 * p) {
+        data.assign(size_t(stride) * size_t(h + 2 * p), 0.f);
+    }
+    // Row y (-pad <= y < height + pad); index it with -pad <= x < width + pad.
+    float* row(int y) { return data.data() + size_t(y + pad) * size_t(stride) + size_t(pad); }
+    const float* row(int y) const { return data.data() + size_t(y + pad) * size_t(stride) + size_t(pad); }
+    float& at(int x, int y) { return row(y)[x]; }
+    float at(int x, int y) const { return row(y)[x]; }
+
+    // Copies the edge pixels into the padding (clamp-to-edge).
+    void replicateEdges() {
+        for (int y = 0; y < height; ++y) {
+            float* r = row(y);
+            for (int x = -pad; x < 0; ++x) r[x] = r[0];
+            for (int x = width; x < width + pad; ++x) r[x] = r[width - 1];
+        }
+        for (int y = -pad; y < 0; ++y) std::memcpy(row(y) - pad, row(0) - pad, sizeof(float) * size_t(stride));
+        for (int y = height; y < height + pad; ++y)
+            std::memcpy(row(y) - pad, row(height - 1) - pad, sizeof(float) * size_t(stride));
+    }
+};
+
+template <class RowFunction>
+void forEachRow(int height, const RowFunction& f) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
+        for (int y = r.begin(); y != r.end(); ++y) f(y);
+    });
+}
+
+// A box of `radius` around each pixel, averaged over the pixels inside the
+// image (separable, direct sums: cheap next to the NL-means passes).
+Plane boxAverage(const Plane& in, int radius) {
+    const int w = in.width, h = in.height;
+    Plane horizontal(w, h, in.pad), out(w, h, in.pad);
+    forEachRow(h, [&](int y) {
+        const float* src = in.row(y);
+        float* dst = horizontal.row(y);
+        for (int x = 0; x < w; ++x) {
+            const int x0 = std::max(0, x - radius), x1 = std::min(w - 1, x + radius);
+            float sum = 0;
+            for (int i = x0; i <= x1; ++i) sum += src[i];
+            dst[x] = sum / float(x1 - x0 + 1);
+        }
+    });
+    forEachRow(h, [&](int y) {
+        const int y0 = std::max(0, y - radius), y1 = std::min(h - 1, y + radius);
+        float* dst = out.row(y);
+        for (int x = 0; x < w; ++x) dst[x] = 0;
+        for (int i = y0; i <= y1; ++i) {
+            const float* src = horizontal.row(i);
+            for (int x = 0; x < w; ++x) dst[x] += src[x];
+        }
+        const float scale = 1.f / float(y1 - y0 + 1);
+        for (int x = 0; x < w; ++x) dst[x] *= scale;
+    });
+    out.replicateEdges();
+    return out;
+}
+
+// Distances are clamped to [0, 87] before expMinus: a negative distance
+// (two values closer than their noise) weighs 1, and e^-87 < 2e-38 is as good
+// as 0. A loop of its own, since a clamp in the loop of the exponential keeps
+// GCC from vectorising it (the conversion to int may trap).
+inline float clampDistance(float d) {
+    d = d > 0.f ? d : 0.f;
+    return d < 87.f ? d : 87.f;
+}
+
+// e^-d for d in [0, 87] without a library call, so the weight loops
+// vectorise: -d = (i + f) / log2(e) with f in [-1/2, 1/2], 2^f by its Taylor
+// series to degree 6, 2^i in the exponent bits. Relative error below 7e-7
+// for d < 10 and 4e-6 near 87 (the rounding of d log2(e) dominates).
+inline float expMinus(float d) {
+    const float t = d * -1.44269504f;
+    const int i = int(t - 0.5f);  // t <= 0: truncation rounds to nearest
+    const float f = (t - float(i)) * 0.693147181f;
+    const float p =
+        1.f + f * (1.f + f * (0.5f + f * (1.f / 6 + f * (1.f / 24 + f * (1.f / 120 + f * (1.f / 720))))));
+    const int32_t bits = (i + 127) << 23;
+    float scale;
+    std::memcpy(&scale, &bits, sizeof scale);
+    return p * scale;
+}
+
+// ---------------------------------------------------------------------------
+// Patch distances: the NL-means distance of Rousselle, Knaus and Zwicker
+// 2012, with the variance cancellation, as Rousselle, Manzi and Zwicker 2013
+// use it for their colour weights. Per channel i
+//   d_i^2(p, q) = ((u_i(p) - u_i(q))^2 - (Var_i[p] + min(Var_i[p], Var_i[q])))
+//                 / (eps + k^2 (Var_i[p] + Var_i[q])),
+// averaged over the channels and over the (2f+1)^2 pixel pairs (p+n, q+n) of
+// the two patches; the weight is exp(-max(0, d^2)). The variance terms cancel
+// the expected squared difference of two noisy values, so equal means give a
+// distance of about 0 whatever the noise.
+
+// The values whose patches are compared, one plane per channel, with their
+// variances. `secondValues`, when given, are the other half render: both
+// halves' distances come from one pass, as they share the variances and so
+// the division.
+struct Guide {
+    std::vector<const Plane*> values, secondValues, variances;
+    float k2 = 1;    // k^2
+    float norm = 1;  // 1 / (channels (2f+1)^2)
+};
+
+// d_i^2 summed over the channels of `g` for the pixels x0 <= x < x1 of row y
+// and their partners at (x + dx, y + dy), into e[0 .. x1-x0) (and second[]
+// for the second values).
+void guideRowDistance(const Guide& g, int y, int dx, int dy, int x0, int x1, float* __restrict e,
+                      float* __restrict second) {
+    const int n = x1 - x0;
+    const bool pair = !g.secondValues.empty();
+    const float k2 = g.k2;
+    for (int x = 0; x < n; ++x) e[x] = 0;
+    if (pair)
+        for (int x = 0; x < n; ++x) second[x] = 0;
+    for (size_t c = 0; c < g.values.size(); ++c) {
+        const float* __restrict up = g.values[c]->row(y) + x0;
+        const float* __restrict uq = g.values[c]->row(y + dy) + x0 + dx;
+        const float* __restrict vp = g.variances[c]->row(y) + x0;
+        const float* __restrict vq = g.variances[c]->row(y + dy) + x0 + dx;
+        if (!pair) {
+            for (int x = 0; x < n; ++x) {
+                const float d = up[x] - uq[x];
+                const float vmin = vp[x] < vq[x] ? vp[x] : vq[x];
+                e[x] += (d * d - (vp[x] + vmin)) / (DistanceEpsilon + k2 * (vp[x] + vq[x]));
+            }
+            continue;
+        }
+        const float* __restrict sp = g.secondValues[c]->row(y) + x0;
+        const float* __restrict sq = g.secondValues[c]->row(y + dy) + x0 + dx;
+        for (int x = 0; x < n; ++x) {
+            const float d = up[x] - uq[x], ds = sp[x] - sq[x];
+            const float vmin = vp[x] < vq[x] ? vp[x] : vq[x];
+            const float cancel = vp[x] + vmin;
+            const float scale = 1.f / (DistanceEpsilon + k2 * (vp[x] + vq[x]));
+            e[x] += (d * d - cancel) * scale;
+            second[x] += (ds * ds - cancel) * scale;
+        }
+    }
+    for (int x = 0; x < n; ++x) e[x] = e[x] < DistanceClamp ? e[x] : DistanceClamp;  // NaN-safe
+    if (pair)
+        for (int x = 0; x < n; ++x) second[x] = second[x] < DistanceClamp ? second[x] : DistanceClamp;
+}
+
+// The rectangle [x0, x1) x [y0, y1) of a tile whose partners (x + dx, y + dy)
+// lie inside the image: the search window is clamped to the image.
+struct Rect {
+    int x0, y0, x1, y1;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    bool empty() const { return x1 <= x0 || y1 <= y0; }
+};
+
+Rect partnersInside(const Rect& tile, int dx, int dy, int width, int height) {
+    return {std::max(tile.x0, -dx), std::max(tile.y0, -dy), std::min(tile.x1, width - dx),
+            std::min(tile.y1, height - dy)};
+}
+
+// Scratch of the box filter, sized for one tile and two sets of values.
+struct BoxScratch {
+    std::vector<float> rowDistance, horizontal, column;
+    BoxScratch(int tile, int f)
+        : rowDistance(2 * size_t(tile + 2 * f) * size_t(tile + 2 * f)),
+          horizontal(2 * size_t(tile + 2 * f) * size_t(tile)), column(size_t(tile)) {}
+};
+
+// Running sums of 2f+1 consecutive values along `rows` rows of `e` (row
+// stride `stride`) into h (row stride w): h[x] = e[x] + ... + e[x + 2f].
+// Four rows at a time, so that four independent chains of additions overlap
+// (one chain alone waits on the latency of each addition).
+void horizontalBoxSums(const float* e, int stride, int rows, int w, int f, float* h) {
+    const int span = 2 * f + 1;
+    int i = 0;
+    for (; i + 4 <= rows; i += 4) {
+        const float* __restrict e0 = e + size_t(i) * size_t(stride);
+        const float* __restrict e1 = e0 + stride;
+        const float* __restrict e2 = e1 + stride;
+        const float* __restrict e3 = e2 + stride;
+        float* __restrict h0 = h + size_t(i) * size_t(w);
+        float* __restrict h1 = h0 + w;
+        float* __restrict h2 = h1 + w;
+        float* __restrict h3 = h2 + w;
+        float s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+        for (int k = 0; k < span; ++k) s0 += e0[k], s1 += e1[k], s2 += e2[k], s3 += e3[k];
+        h0[0] = s0, h1[0] = s1, h2[0] = s2, h3[0] = s3;
+        for (int x = 1; x < w; ++x) {
+            s0 += e0[x + 2 * f] - e0[x - 1];
+            s1 += e1[x + 2 * f] - e1[x - 1];
+            s2 += e2[x + 2 * f] - e2[x - 1];
+            s3 += e3[x + 2 * f] - e3[x - 1];
+            h0[x] = s0, h1[x] = s1, h2[x] = s2, h3[x] = s3;
+        }
+    }
+    for (; i < rows; ++i) {
+        const float* __restrict e0 = e + size_t(i) * size_t(stride);
+        float* __restrict h0 = h + size_t(i) * size_t(w);
+        float s0 = 0;
+        for (int k = 0; k < span; ++k) s0 += e0[k];
+        h0[0] = s0;
+        for (int x = 1; x < w; ++x) {
+            s0 += e0[x + 2 * f] - e0[x - 1];
+            h0[x] = s0;
+        }
+    }
+}
+
+// Running sums down the columns of `rows` + 2f rows of h (row stride w).
+void verticalBoxSums(const float* h, int rows, int w, int f, float* column, float* out) {
+    const int span = 2 * f + 1;
+    for (int x = 0; x < w; ++x) column[x] = 0;
+    for (int k = 0; k < span; ++k) {
+        const float* __restrict hk = h + size_t(k) * size_t(w);
+        for (int x = 0; x < w; ++x) column[x] += hk[x];
+    }
+    for (int y = 0; y < rows; ++y) {
+        float* __restrict o = out + size_t(y) * size_t(w);
+        for (int x = 0; x < w; ++x) o[x] = column[x];
+        if (y + 1 == rows) break;
+        const float* __restrict enter = h + size_t(y + span) * size_t(w);
+        const float* __restrict leave = h + size_t(y) * size_t(w);
+        for (int x = 0; x < w; ++x) column[x] += enter[x] - leave[x];
+    }
+}
+
+// Patch distances of one offset for every pixel of `r`: the pixel distances
+// of the rectangle grown by f, box-filtered by running sums along the rows,
+// then down the columns, so the cost per pixel does not depend on the patch
+// size. out[(y - r.y0) * r.width() + (x - r.x0)] = the (unnormalised) sum;
+// second[] the same for the guide's second values.
+void patchDistances(const Guide& g, const Rect& r, int dx, int dy, int f, BoxScratch& s, float* out,
+                    float* second) {
+    const int w = r.width(), rows = r.height() + 2 * f, stride = w + 2 * f;
+    const bool pair = !g.secondValues.empty();
+    float* e = s.rowDistance.data();
+    float* eSecond = e + size_t(rows) * size_t(stride);  // the second set's rows follow the first's
+    for (int i = 0; i < rows; ++i)
+        guideRowDistance(g, r.y0 - f + i, dx, dy, r.x0 - f, r.x1 + f, e + size_t(i) * size_t(stride),
+                         eSecond + size_t(i) * size_t(stride));
+    horizontalBoxSums(e, stride, pair ? 2 * rows : rows, w, f, s.horizontal.data());
+    verticalBoxSums(s.horizontal.data(), r.height(), w, f, s.column.data(), out);
+    if (pair)
+        verticalBoxSums(s.horizontal.data() + size_t(rows) * size_t(w), r.height(), w, f, s.column.data(), second);
+}
+
+template <class TileFunction>
+void forEachTile(int width, int height, const TileFunction& f) {
+    const int tilesX = (width + TileSize - 1) / TileSize, tilesY = (height + TileSize - 1) / TileSize;
+    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& range) {
+        for (int t = range.begin(); t != range.end(); ++t) {
+            const int tx = t % tilesX, ty = t / tilesX;
+            f(Rect{tx * TileSize, ty * TileSize, std::min(width, (tx + 1) * TileSize),
+                   std::min(height, (ty + 1) * TileSize)});
+        }
+    });
+}
+
+// ---------------------------------------------------------------------------
+// Inputs as planes.
+
+bool finite(float v) { return std::isfinite(v); }
+float clampMagnitude(float v, float limit) { return v < -limit ? -limit : (v > limit ? limit : v); }
+
+// One channel of the two halves. A value non-finite in one half takes the
+// other half's; non-finite in both, the mean of the finite 3x3 neighbours
+// (of both halves), else 0. Finite values are clamped to +-ColorLimit.
+void loadHalves(const std::vector<float>& a, const std::vector<float>& b, int w, int h, int pad, Plane& outA,
+                Plane& outB) {
+    outA = Plane(w, h, pad);
+    outB = Plane(w, h, pad);
+    std::vector<float> meanOfHalves(a.size());
+    std::vector<uint8_t> missing(a.size());
+    forEachRow(h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            float va = a[i], vb = b[i];
+            if (!finite(va)) va = vb;
+            if (!finite(vb)) vb = va;
+            missing[i] = !finite(va);
+            outA.at(x, y) = missing[i] ? 0.f : clampMagnitude(va, ColorLimit);
+            outB.at(x, y) = missing[i] ? 0.f : clampMagnitude(vb, ColorLimit);
+            meanOfHalves[i] = 0.5f * (outA.at(x, y) + outB.at(x, y));
+        }
+    });
+    forEachRow(h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            if (!missing[size_t(y) * size_t(w) + size_t(x)]) continue;
+            float sum = 0;
+            int count = 0;
+            for (int j = std::max(0, y - 1); j <= std::min(h - 1, y + 1); ++j)
+                for (int i = std::max(0, x - 1); i <= std::min(w - 1, x + 1); ++i) {
+                    const size_t k = size_t(j) * size_t(w) + size_t(i);
+                    if (!missing[k]) sum += meanOfHalves[k], ++count;
+                }
+            outA.at(x, y) = outB.at(x, y) = count ? sum / float(count) : 0.f;
+        }
+    });
+    outA.replicateEdges();
+    outB.replicateEdges();
+}
+
+std::vector<float> channelOf(const std::vector<Color>& v, int c) {
+    std::vector<float> out(v.size());
+    for (size_t i = 0; i < v.size(); ++i) out[i] = v[i][c];
+    return out;
+}
+
+// Per-pixel variance of one half: E[(A - B)^2] = 2 Var[half] for independent
+// halves of equal variance; (A - B)^2 has one degree of freedom, so it is
+// box-smoothed first (the two-buffer variance of Rousselle et al. 2012).
+Plane halfVariance(const Plane& a, const Plane& b, int radius) {
+    Plane sq(a.width, a.height, a.pad);
+    forEachRow(a.height, [&](int y) {
+        const float* pa = a.row(y);
+        const float* pb = b.row(y);
+        float* out = sq.row(y);
+        for (int x = 0; x < a.width; ++x) out[x] = 0.5f * (pa[x] - pb[x]) * (pa[x] - pb[x]);
+    });
+    return boxAverage(sq, radius);
+}
+
+// A feature: its channels, denoised, with their summed variance and the
+// inverse scale of the feature distance.
+struct Feature {
+    std::vector<Plane> channels;  // raw, then prefiltered
+    std::vector<Plane> variances; // per channel, of the raw values
+    Plane varianceSum;            // over the channels, after prefiltering
+    Plane inverseScale;           // 1 / (k_f^2 max(tau, Var, |grad|^2))
+};
+
+Plane featurePlane(const std::vector<float>& v, int w, int h, int pad, float missingValue) {
+    Plane p(w, h, pad);
+    forEachRow(h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            const float value = v[size_t(y) * size_t(w) + size_t(x)];
+            p.at(x, y) = finite(value) ? clampMagnitude(value, FeatureLimit) : missingValue;
+        }
+    });
+    p.replicateEdges();
+    return p;
+}
+
+// Depth in [0, 1): z / (z + the median depth of the pixels that met
+// something), so that the feature scale (tau) is relative to the scene's
+// depth and "nothing met" (1e10, non-finite) is 1, the far limit. Empty when
+// no pixel met anything.
+std::vector<float> normalisedDepth(const std::vector<float>& depth) {
+    std::vector<float> met;
+    for (float z : depth)
+        if (finite(z) && z < FarDepth) met.push_back(std::max(z, 0.f));
+    if (met.empty()) return {};
+    std::nth_element(met.begin(), met.begin() + met.size() / 2, met.end());
+    const float median = met[met.size() / 2];
+    const float reference = median > 0 ? median : 1.f;
+    std::vector<float> out(depth.size());
+    for (size_t i = 0; i < depth.size(); ++i) {
+        const float z = depth[i];
+        out[i] = finite(z) && z < FarDepth ? std::max(z, 0.f) / (std::max(z, 0.f) + reference) : 1.f;
+    }
+    return out;
+}
+
+// The median of n <= 8 values (the mean of the middle two for even n),
+// sorting them in place. Eight values (every pixel but the border ones) go
+// through a branch-free sorting network of 19 compare-exchanges (the fewest
+// for 8 inputs; Knuth, TAOCP vol. 3, section 5.3.4), as random data defeats
+// branch prediction; fewer, by insertion.
+float medianOf(float* v, int n) {
+    if (n == 8) {
+        auto exchange = [v](int i, int j) {
+            const float lo = std::min(v[i], v[j]), hi = std::max(v[i], v[j]);
+            v[i] = lo, v[j] = hi;
+        };
+        exchange(0, 2), exchange(1, 3), exchange(4, 6), exchange(5, 7);
+        exchange(0, 4), exchange(1, 5), exchange(2, 6), exchange(3, 7);
+        exchange(0, 1), exchange(2, 3), exchange(4, 5), exchange(6, 7);
+        exchange(2, 4), exchange(3, 5);
+        exchange(1, 4), exchange(3, 6);
+        exchange(1, 2), exchange(3, 4), exchange(5, 6);
+        return 0.5f * (v[3] + v[4]);
+    }
+    for (int i = 1; i < n; ++i)
+        for (int j = i; j > 0 && v[j] < v[j - 1]; --j) std::swap(v[j], v[j - 1]);
+    if (n == 0) return 0.f;
+    return n % 2 ? v[n / 2] : 0.5f * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Noise variance of a feature channel that comes without halves: the median
+// of the squared differences to the 8 neighbours (robust at edges, where at
+// most 3 of them lie across), over its value for pure Gaussian noise, then
+// box-averaged over 5x5 (one pixel's median is itself noisy).
+Plane robustNoiseVariance(const Plane& f) {
+    const int w = f.width, h = f.height;
+    Plane median(w, h, f.pad);
+    forEachRow(h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            float d[8];
+            int n = 0;
+            for (int j = -1; j <= 1; ++j)
+                for (int i = -1; i <= 1; ++i) {
+                    if ((i == 0 && j == 0) || x + i < 0 || x + i >= w || y + j < 0 || y + j >= h) continue;
+                    const float diff = f.at(x, y) - f.at(x + i, y + j);
+                    d[n++] = diff * diff;
+                }
+            const float m = medianOf(d, n);
+            median.at(x, y) = m / MedianSquaredDifferenceScale;
+        }
+    });
+    return boxAverage(median, 2);
+}
+
+// ---------------------------------------------------------------------------
+// Feature prefilter: NL-means of all the feature channels together, guided by
+// themselves (as NFOR, Bitterli et al. 2016, section 5.1, prefilters its
+// features; without the two feature halves it has, the guide is the feature
+// itself). The variance after filtering is Var[p] sum w^2 / (sum w)^2.
+void prefilterFeatures(std::vector<Feature>& features, const DenoiseOptions& o, int w, int h, int pad) {
+    Guide guide;
+    for (const Feature& f : features)
+        for (size_t c = 0; c < f.channels.size(); ++c) {
+            guide.values.push_back(&f.channels[c]);
+            guide.variances.push_back(&f.variances[c]);
+        }
+    const int channels = int(guide.values.size());
+    const int radius = o.featureSearchRadius, f = o.featurePatchRadius;
+    guide.k2 = o.featurePrefilterStrength * o.featurePrefilterStrength;
+    guide.norm = 1.f / float(channels * (2 * f + 1) * (2 * f + 1));
+
+    std::vector<Plane> filtered(size_t(channels), Plane(w, h, pad));
+    Plane varianceFactor(w, h, pad);  // sum w^2 / (sum w)^2
+    forEachTile(w, h, [&](const Rect& tile) {
+        const int tw = tile.width(), n = tw * tile.height();
+        BoxScratch scratch(TileSize, f);
+        std::vector<float> distance(static_cast<size_t>(n)), weight(static_cast<size_t>(tw));
+        std::vector<float> sum(size_t(channels) * size_t(n), 0.f), weights(size_t(n), 0.f), squares(size_t(n), 0.f);
+        for (int dy = -radius; dy <= radius; ++dy)
+            for (int dx = -radius; dx <= radius; ++dx) {
+                const Rect r = partnersInside(tile, dx, dy, w, h);
+                if (r.empty()) continue;
+                patchDistances(guide, r, dx, dy, f, scratch, distance.data(), nullptr);
+                for (int y = r.y0; y < r.y1; ++y) {
+                    const float* __restrict d = &distance[size_t(y - r.y0) * size_t(r.width())];
+                    float* __restrict wr = weight.data();
+                    for (int x = 0; x < r.width(); ++x) wr[x] = clampDistance(d[x] * guide.norm);
+                    for (int x = 0; x < r.width(); ++x) wr[x] = expMinus(wr[x]);
+                    const size_t base = size_t(y - tile.y0) * size_t(tw) + size_t(r.x0 - tile.x0);
+                    float* __restrict ws = &weights[base];
+                    float* __restrict w2 = &squares[base];
+                    for (int x = 0; x < r.width(); ++x) ws[x] += wr[x], w2[x] += wr[x] * wr[x];
+                    for (int c = 0; c < channels; ++c) {
+                        const float* __restrict q = guide.values[size_t(c)]->row(y + dy) + r.x0 + dx;
+                        float* __restrict s = &sum[size_t(c) * size_t(n) + base];
+                        for (int x = 0; x < r.width(); ++x) s[x] += wr[x] * q[x];
+                    }
+                }
+            }
+        for (int y = tile.y0; y < tile.y1; ++y)
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
+                for (int c = 0; c < channels; ++c)
+                    filtered[size_t(c)].at(x, y) = sum[size_t(c) * size_t(n) + i] / weights[i];
+                varianceFactor.at(x, y) = squares[i] / (weights[i] * weights[i]);
+            }
+    });
+
+    int c = 0;
+    for (Feature& feature : features) {
+        feature.varianceSum = Plane(w, h, pad);
+        for (size_t k = 0; k < feature.channels.size(); ++k, ++c) {
+            feature.channels[k] = std::move(filtered[size_t(c)]);
+            feature.channels[k].replicateEdges();
+            forEachRow(h, [&](int y) {
+                for (int x = 0; x < w; ++x)
+                    feature.varianceSum.at(x, y) += feature.variances[k].at(x, y) * varianceFactor.at(x, y);
+            });
+        }
+        feature.varianceSum.replicateEdges();
+        feature.variances.clear();
+    }
+}
+
+// 1 / (k_f^2 max(tau, Var_j[p], |grad f_j(p)|^2)): the scale of feature j's
+// distance (Rousselle, Manzi and Zwicker 2013). The gradient term keeps smooth
+// ramps (depth of a slanted surface) from reading as edges.
+void featureScales(std::vector<Feature>& features, const DenoiseOptions& o, int w, int h, int pad) {
+    const float k2 = o.featureStrength * o.featureStrength;
+    for (Feature& feature : features) {
+        feature.inverseScale = Plane(w, h, pad);
+        forEachRow(h, [&](int y) {
+            for (int x = 0; x < w; ++x) {
+                float gradient2 = 0;
+                for (const Plane& c : feature.channels) {
+                    const float gx = 0.5f * (c.at(x + 1, y) - c.at(x - 1, y));
+                    const float gy = 0.5f * (c.at(x, y + 1) - c.at(x, y - 1));
+                    gradient2 += gx * gx + gy * gy;
+                }
+                const float scale = std::max(o.featureThreshold, std::max(feature.varianceSum.at(x, y), gradient2));
+                feature.inverseScale.at(x, y) = 1.f / (k2 * scale);
+            }
+        });
+        feature.inverseScale.replicateEdges();
+    }
+}
+
+// max over the features j of their distance (Rousselle et al. 2013):
+//   (|f_j(p) - f_j(q)|^2 - (Var_j[p] + min(Var_j[p], Var_j[q]))) / (k_f^2 max(...)),
+// pixel to pixel (the features are prefiltered), for row y, pixels x0 <= x < x1.
+void featureRowDistance(const std::vector<Feature>& features, int y, int dx, int dy, int x0, int x1,
+                        float* __restrict out, float* __restrict scratch) {
+    const int n = x1 - x0;
+    for (int x = 0; x < n; ++x) out[x] = 0;
+    for (const Feature& feature : features) {
+        // |f_j(p) - f_j(q)|^2: one pass for the three channels of a colour
+        // or vector feature, else channel by channel.
+        const std::vector<Plane>& c = feature.channels;
+        if (c.size() == 3) {
+            const float* __restrict p0 = c[0].row(y) + x0;
+            const float* __restrict q0 = c[0].row(y + dy) + x0 + dx;
+            const float* __restrict p1 = c[1].row(y) + x0;
+            const float* __restrict q1 = c[1].row(y + dy) + x0 + dx;
+            const float* __restrict p2 = c[2].row(y) + x0;
+            const float* __restrict q2 = c[2].row(y + dy) + x0 + dx;
+            for (int x = 0; x < n; ++x) {
+                const float d0 = p0[x] - q0[x], d1 = p1[x] - q1[x], d2 = p2[x] - q2[x];
+                scratch[x] = d0 * d0 + d1 * d1 + d2 * d2;
+            }
+        } else {
+            for (int x = 0; x < n; ++x) scratch[x] = 0;
+            for (const Plane& channel : c) {
+                const float* __restrict fp = channel.row(y) + x0;
+                const float* __restrict fq = channel.row(y + dy) + x0 + dx;
+                for (int x = 0; x < n; ++x) {
+                    const float d = fp[x] - fq[x];
+                    scratch[x] += d * d;
+                }
+            }
+        }
+        const float* __restrict vp = feature.varianceSum.row(y) + x0;
+        const float* __restrict vq = feature.varianceSum.row(y + dy) + x0 + dx;
+        const float* __restrict s = feature.inverseScale.row(y) + x0;
+        for (int x = 0; x < n; ++x) {
+            const float vmin = vp[x] < vq[x] ? vp[x] : vq[x];
+            const float d = (scratch[x] - (vp[x] + vmin)) * s[x];
+            out[x] = d > out[x] ? d : out[x];
+        }
+    }
+}
+
+void checkSize(size_t size, size_t pixels, const char* name, bool optional) {
+    if (size == pixels || (optional && size == 0)) return;
+    throw std::invalid_argument(str("denoise: ", name, " has ", size, " entries, expected ", pixels,
+                                    optional ? " (or none)" : ""));
+}
+
+void checkOptions(const DenoiseOptions& o) {
+    auto radius = [](int r, const char* name) {
+        if (r < 0 || r > 32) throw std::invalid_argument(str("denoise: ", name, " ", r, " is outside [0, 32]"));
+    };
+    auto positive = [](float v, const char* name) {
+        if (!(v > 0) || !finite(v)) throw std::invalid_argument(str("denoise: ", name, " ", v, " must be positive"));
+    };
+    if (o.threads < 0) throw std::invalid_argument(str("denoise: threads ", o.threads, " is negative"));
+    radius(o.searchRadius, "searchRadius");
+    radius(o.patchRadius, "patchRadius");
+    radius(o.varianceRadius, "varianceRadius");
+    radius(o.featureSearchRadius, "featureSearchRadius");
+    radius(o.featurePatchRadius, "featurePatchRadius");
+    positive(o.colorStrength, "colorStrength");
+    positive(o.featureStrength, "featureStrength");
+    positive(o.featureThreshold, "featureThreshold");
+    positive(o.featurePrefilterStrength, "featurePrefilterStrength");
+}
+
+}  // namespace
+
+Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
+    if (in.width < 0 || in.height < 0)
+        throw std::invalid_argument(str("denoise: invalid frame size ", in.width, "x", in.height));
+    checkOptions(options);
+    const int w = in.width, h = in.height;
+    const size_t pixels = size_t(w) * size_t(h);
+    checkSize(in.halfA.size(), pixels, "halfA", false);
+    checkSize(in.halfB.size(), pixels, "halfB", false);
+    checkSize(in.alphaA.size(), pixels, "alphaA", true);
+    checkSize(in.alphaB.size(), pixels, "alphaB", true);
+    if (in.alphaA.empty() != in.alphaB.empty())
+        throw std::invalid_argument("denoise: alphaA and alphaB must both be given or both be empty");
+    checkSize(in.albedo.size(), pixels, "albedo", true);
+    checkSize(in.normal.size(), pixels, "normal", true);
+    checkSize(in.depth.size(), pixels, "depth", true);
+    Image out(w, h);
+    if (pixels == 0) return out;
+
+    const bool hasAlpha = !in.alphaA.empty();
+    const int pad = std::max({options.patchRadius, options.featurePatchRadius, 1});
+    tbb::task_arena arena(resolveThreadCount(options.threads));
+    arena.execute([&] {
+        // Colour and alpha of both halves, and the variance of one half.
+        const int channels = hasAlpha ? 4 : 3;
+        const size_t planes = static_cast<size_t>(channels);
+        std::vector<Plane> a(planes), b(planes), variance(planes);
+        for (int c = 0; c < channels; ++c) {
+            if (c < 3)
+                loadHalves(channelOf(in.halfA, c), channelOf(in.halfB, c), w, h, pad, a[size_t(c)], b[size_t(c)]);
+            else
+                loadHalves(in.alphaA, in.alphaB, w, h, pad, a[3], b[3]);
+            variance[size_t(c)] = halfVariance(a[size_t(c)], b[size_t(c)], options.varianceRadius);
+        }
+
+        // Features, normalised to about [0, 1]: albedo and normal as they are
+        // (0 where nothing was met), depth relative to the median depth.
+        std::vector<Feature> features;
+        if (options.useFeatures) {
+            auto add = [&](const std::vector<std::vector<float>>& channelValues, float missingValue) {
+                Feature f;
+                for (const auto& v : channelValues) {
+                    f.channels.push_back(featurePlane(v, w, h, pad, missingValue));
+                    f.variances.push_back(robustNoiseVariance(f.channels.back()));
+                }
+                features.push_back(std::move(f));
+            };
+            auto channels3 = [](const std::vector<Color>& v) {
+                return std::vector<std::vector<float>>{channelOf(v, 0), channelOf(v, 1), channelOf(v, 2)};
+            };
+            if (!in.albedo.empty()) add(channels3(in.albedo), 0.f);
+            if (!in.normal.empty()) add(channels3(in.normal), 0.f);
+            if (!in.depth.empty()) {
+                std::vector<float> depth = normalisedDepth(in.depth);
+                if (!depth.empty()) add({depth}, 1.f);
+            }
+            if (!features.empty()) {
+                prefilterFeatures(features, options, w, h, pad);
+                featureScales(features, options, w, h, pad);
+            }
+        }
+
+        // Cross-filtering (Rousselle et al. 2012 and 2013): half A is
+        // averaged with weights from half B's patches and vice versa, so the
+        // weights' residual noise is independent of the values they average;
+        // the output is the mean of the two. The final weight is
+        // min(colour weight, feature weight) (Rousselle et al. 2013), one
+        // exponential of the larger distance.
+        const int f = options.patchRadius, radius = options.searchRadius;
+        Guide halves;
+        for (int c = 0; c < channels; ++c) {
+            halves.values.push_back(&a[size_t(c)]);
+            halves.secondValues.push_back(&b[size_t(c)]);
+            halves.variances.push_back(&variance[size_t(c)]);
+        }
+        halves.k2 = options.colorStrength * options.colorStrength;
+        halves.norm = 1.f / float(channels * (2 * f + 1) * (2 * f + 1));
+
+        forEachTile(w, h, [&](const Rect& tile) {
+            const int tw = tile.width(), n = tw * tile.height();
+            const size_t tilePixels = static_cast<size_t>(n), tileRow = static_cast<size_t>(tw);
+            BoxScratch scratch(TileSize, f);
+            std::vector<float> distanceA(tilePixels), distanceB(tilePixels), featureDistance(tileRow),
+                featureScratch(tileRow), weightA(tileRow), weightB(tileRow);
+            // Sums of w * value per channel (A filtered with B's weights, and
+            // B with A's), then the sums of the weights.
+            std::vector<float> sumA(size_t(channels) * size_t(n), 0.f), sumB(size_t(channels) * size_t(n), 0.f),
+                weightsA(size_t(n), 0.f), weightsB(size_t(n), 0.f);
+            for (int dy = -radius; dy <= radius; ++dy)
+                for (int dx = -radius; dx <= radius; ++dx) {
+                    const Rect r = partnersInside(tile, dx, dy, w, h);
+                    if (r.empty()) continue;
+                    patchDistances(halves, r, dx, dy, f, scratch, distanceA.data(), distanceB.data());
+                    const int rw = r.width();
+                    for (int y = r.y0; y < r.y1; ++y) {
+                        float* __restrict fd = featureDistance.data();
+                        if (!features.empty())
+                            featureRowDistance(features, y, dx, dy, r.x0, r.x1, fd, featureScratch.data());
+                        else
+                            for (int x = 0; x < rw; ++x) fd[x] = 0;
+                        const float* __restrict dB = &distanceB[size_t(y - r.y0) * size_t(rw)];
+                        const float* __restrict dA = &distanceA[size_t(y - r.y0) * size_t(rw)];
+                        float* __restrict wA = weightA.data();
+                        float* __restrict wB = weightB.data();
+                        const float norm = halves.norm;
+                        for (int x = 0; x < rw; ++x) {
+                            const float colourB = dB[x] * norm, colourA = dA[x] * norm;
+                            wA[x] = clampDistance(colourB > fd[x] ? colourB : fd[x]);
+                            wB[x] = clampDistance(colourA > fd[x] ? colourA : fd[x]);
+                        }
+                        for (int x = 0; x < rw; ++x) wA[x] = expMinus(wA[x]), wB[x] = expMinus(wB[x]);
+                        const size_t base = size_t(y - tile.y0) * size_t(tw) + size_t(r.x0 - tile.x0);
+                        float* __restrict sa = &weightsA[base];
+                        float* __restrict sb = &weightsB[base];
+                        for (int x = 0; x < rw; ++x) sa[x] += wA[x], sb[x] += wB[x];
+                        for (int c = 0; c < channels; ++c) {
+                            const float* __restrict qa = a[size_t(c)].row(y + dy) + r.x0 + dx;
+                            const float* __restrict qb = b[size_t(c)].row(y + dy) + r.x0 + dx;
+                            float* __restrict accA = &sumA[size_t(c) * size_t(n) + base];
+                            float* __restrict accB = &sumB[size_t(c) * size_t(n) + base];
+                            for (int x = 0; x < rw; ++x) accA[x] += wA[x] * qa[x], accB[x] += wB[x] * qb[x];
+                        }
+                    }
+                }
+
+            // The centre weight is 1 (its distances are <= 0; to the rounding
+            // of the running sums), so the sums of the weights are about >= 1.
+            for (int y = tile.y0; y < tile.y1; ++y)
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
+                    float value[4] = {0, 0, 0, 1};
+                    for (int c = 0; c < channels; ++c) {
+                        const size_t k = size_t(c) * size_t(n) + i;
+                        float v = 0.5f * (sumA[k] / weightsA[i] + sumB[k] / weightsB[i]);
+                        if (!finite(v)) v = 0.5f * (a[size_t(c)].at(x, y) + b[size_t(c)].at(x, y));
+                        value[c] = v;
+                    }
+                    out.set(x, y, Color(value[0], value[1], value[2]), value[3]);
+                }
+        });
+    });
+    return out;
+}
+
+}  // namespace vdbmarch
