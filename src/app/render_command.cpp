@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/denoise_frame.h"
 #include "app/tiles.h"
 #include "app/vdb_check.h"
 #include "core/atomic_file.h"
@@ -192,6 +193,12 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     }
     if (tile.count > 0 || tile.cropped) options.crop = window;
     if (tile.byPasses()) options.passes = std::make_pair(tile.firstPass, tile.endPass);
+    // The denoiser (docs/denoise.md) works on the two half renders: of the
+    // whole frame here, of a tile's after merge (a tile alone would show seams).
+    const RenderSettings::Denoise denoiseMode = desc.render.denoise;
+    const bool denoiseHere = denoiseMode == RenderSettings::Denoise::On ||
+                             (denoiseMode == RenderSettings::Denoise::Preview && !a.png.empty());
+    options.keepHalves = tile.any() ? denoiseMode != RenderSettings::Denoise::Off && !tile.byPasses() : denoiseHere;
 
     // Checkpoints: resume from the file when it is there (--resume: it must
     // be), save to it every --checkpoint-every seconds and on a signal.
@@ -254,6 +261,30 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         {"vdbmarch:meanSpp", str(r.meanSpp)},
     };
     for (auto& kv : noiseAttributes(r.noise)) attrs.push_back(std::move(kv));
+    attrs.emplace_back(DenoiseAttribute, denoiseModeName(denoiseMode));
+    Image preview = r.image;
+    double denoiseSeconds = -1;
+    if (options.keepHalves && r.spp < 2) {
+        warn(str("not denoised: the denoiser needs at least 2 samples per pixel (", r.spp, " rendered)"));
+    } else if (options.keepHalves) {
+        std::vector<ExrLayer> halves = {rgbaLayer(EvenHalfLayer, r.evenHalf), rgbaLayer(OddHalfLayer, r.oddHalf)};
+        if (!tile.any()) {
+            const auto d0 = std::chrono::steady_clock::now();
+            std::vector<ExrLayer> inputs = r.layers;
+            inputs.insert(inputs.end(), halves.begin(), halves.end());
+            preview = denoiseFrame(r.image.width, r.image.height, inputs, desc.render.threads);
+            denoiseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+        }
+        // The EXR: the denoised RGBA with the noisy beauty and the halves as
+        // layers; a tile keeps its noisy RGBA and the halves for merge.
+        if (denoiseMode == RenderSettings::Denoise::On || tile.any()) {
+            if (!tile.any()) {
+                r.layers.push_back(rgbaLayer(NoisyLayer, r.image));
+                r.image = preview;
+            }
+            r.layers.insert(r.layers.end(), halves.begin(), halves.end());
+        }
+    }
     if (desc.frame) attrs.emplace_back("vdbmarch:frame", std::to_string(*desc.frame));
     if (!a.cache.empty()) attrs.emplace_back("vdbmarch:cache", a.cache);
     for (auto& kv : tileAttributes(tile, r)) attrs.push_back(std::move(kv));
@@ -261,7 +292,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     writeExr(a.output, r.image, attrs, r.layers,
              ExrWindow{r.window, PixelRect{0, 0, scene->camera->width(), scene->camera->height()}});
     if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
-    if (!a.png.empty()) writePng(a.png, r.image, desc.render.exposure);
+    if (!a.png.empty()) writePng(a.png, preview, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total));
     if (!checkpointPath.empty() && !a.keepCheckpoint) std::remove(checkpointPath.c_str());  // the render is whole
@@ -277,7 +308,9 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
                                r.photonPasses, r.photonPasses == 1 ? " pass, " : " passes, ").c_str()
                          : "",
                      loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str(),
-                     noiseSummary(desc.render, r).c_str());
+                     (noiseSummary(desc.render, r) +
+                      (denoiseSeconds >= 0 ? str("; denoised in ", std::round(denoiseSeconds * 1000) / 1000, " s") : ""))
+                         .c_str());
     return 0;
 }
 

@@ -72,6 +72,10 @@ StringAttributes tileAttributes(const TileRequest& r, const RenderResult& result
     return {};
 }
 
+const char* denoiseModeName(RenderSettings::Denoise mode) {
+    return mode == RenderSettings::Denoise::On ? "on" : mode == RenderSettings::Denoise::Off ? "off" : "preview";
+}
+
 StringAttributes noiseAttributes(const NoiseEstimate& e) {
     if (!e.valid) return {};
     return {{NoiseAttribute, str(e.relative())}, {NoiseRmseAttribute, str(e.rmse)}, {NoiseMeanAttribute, str(e.mean)}};
@@ -231,6 +235,13 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
                                                    {"vdbmarch:photonPasses", str(total)}};
     for (auto& [k, v] : noiseAttributes(estimateNoise(sums))) replaced[k] = v;
     out.frame.attributes = mergedAttributes(parts, replaced);
+    // The two half renders for the denoiser, as one process would keep them.
+    if (ref.attributes.count(DenoiseAttribute) && ref.attribute(DenoiseAttribute) != "off" && sums.samples >= 2) {
+        for (const bool odd : {false, true}) {
+            const Image half = odd ? sums.oddHalf(frame.width(), frame.height()) : sums.evenHalf(frame.width(), frame.height());
+            out.frame.layers.push_back({odd ? "odd" : "even", {"R", "G", "B", "A"}, half.rgba});
+        }
+    }
     return out;
 }
 

@@ -29,6 +29,10 @@ inline constexpr const char* NoiseRmseAttribute = "vdbmarch:noiseRmse";
 inline constexpr const char* NoiseMeanAttribute = "vdbmarch:noiseMean";
 inline constexpr const char* NoiseTargetAttribute = "vdbmarch:noiseTarget";  // render.noise, or "none"
 
+// render.denoise ("on", "preview" or "off"): merge denoises the frame so.
+inline constexpr const char* DenoiseAttribute = "vdbmarch:denoise";
+const char* denoiseModeName(RenderSettings::Denoise mode);
+
 // The three noise attributes of an estimate (none when it is not valid).
 StringAttributes noiseAttributes(const NoiseEstimate& e);
 

@@ -1,0 +1,28 @@
+// The denoiser (denoise/denoise.h) on a whole frame as the render command
+// and merge hold it: the two half renders and the AOV layers that serve as
+// its features, as EXR layers (docs/denoise.md, "In the EXR").
+#pragma once
+
+#include <vector>
+
+#include "image/exr_io.h"
+#include "image/image.h"
+
+namespace vdbmarch {
+
+// Names of the layers a denoised render writes: the noisy beauty and the
+// means of its even- and odd-index samples (RGBA each).
+inline constexpr const char* NoisyLayer = "noisy";
+inline constexpr const char* EvenHalfLayer = "even";
+inline constexpr const char* OddHalfLayer = "odd";
+
+// An RGBA image as a layer named `name`.
+ExrLayer rgbaLayer(const char* name, const Image& img);
+
+// The denoised frame from the half layers (EvenHalfLayer, OddHalfLayer) and
+// the albedo, normal and depth AOV layers among `layers` when present;
+// channels are found by name, in any order. InputError when a half is
+// missing.
+Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads);
+
+}  // namespace vdbmarch
