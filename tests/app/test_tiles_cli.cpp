@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 
 #include "image/exr_io.h"
 #include "support/support.h"
@@ -44,6 +45,38 @@ protected:
     }
     CliResult identical(const std::string& a, const std::string& b) { return cli({"compare", a, b, "--identical"}); }
 };
+
+// Tiles are denoised after merge, on the whole frame (a tile alone would
+// show seams at its edges): the merged, denoised frame and its PNG are those
+// of one process, with the denoised RGBA, the noisy beauty and the halves;
+// with the default (the PNG alone denoised) the merged EXR is the noisy one.
+TEST_F(TilesCli, TilesAreDenoisedAfterMergeLikeOneProcess) {
+    const std::vector<std::string> features = {"--aovs", "albedo,normal,depth"};
+    auto with = [&](std::vector<std::string> a, const std::vector<std::string>& b) {
+        a.insert(a.end(), b.begin(), b.end());
+        return a;
+    };
+    render("single.exr", with(features, {"--denoise", "--png", "single.png"}));
+    renderTiles(3, with(features, {"--denoise", "--threads", "1"}));
+    ASSERT_EQ(merge({"t0.exr", "t1.exr", "t2.exr", "--png", "merged.png"}).exitCode, 0);
+    const CliResult same = identical("merged.exr", "single.exr");
+    EXPECT_EQ(same.exitCode, 0) << same.out;
+    EXPECT_EQ(readBytes(work("merged.png")), readBytes(work("single.png")));
+    std::set<std::string> names;
+    for (const ExrLayer& l : readExrContents(work("single.exr")).layers) names.insert(l.name);
+    for (const char* n : {"noisy", "even", "odd", "albedo", "normal", "depth"}) EXPECT_TRUE(names.count(n)) << n;
+    // The denoised RGBA is not the noisy one.
+    const ExrContents single = readExrContents(work("single.exr"));
+    for (const ExrLayer& l : single.layers)
+        if (l.name == "noisy") EXPECT_NE(l.pixels, single.image.rgba);
+
+    render("p_single.exr", with(features, {"--png", "p_single.png"}));
+    renderTiles(2, features);
+    ASSERT_EQ(merge({"t0.exr", "t1.exr", "--png", "p_merged.png"}, "p_merged.exr").exitCode, 0);
+    EXPECT_EQ(identical("p_merged.exr", "p_single.exr").exitCode, 0);
+    EXPECT_EQ(readBytes(work("p_merged.png")), readBytes(work("p_single.png")));
+    for (const ExrLayer& l : readExrContents(work("p_single.exr")).layers) EXPECT_NE(l.name, "even");
+}
 
 TEST_F(TilesCli, MergedTilesAreBitIdenticalToOneProcess) {
     render("single.exr", {"--aovs", "depth,albedo,direct,indirect"});

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "denoise/denoise.h"
 #include "support/support.h"
 
 namespace vdbmarch::test {
@@ -134,6 +135,32 @@ TEST(NoiseTarget, BadValuesAreRefused) {
         const CliResult r = runCli({"render", samplePath("cloud.json"), "-o", "x.exr", "--noise", v}, dir.path(), dir.path());
         EXPECT_NE(r.exitCode, 0);
         EXPECT_NE(r.err.find("--noise"), std::string::npos) << r.err;
+    }
+}
+
+// A furnace (albedo 1 under a uniform background of 1): every pixel's
+// expectation is 1, and denoising the render's halves keeps the mean within
+// the raw image's standard error.
+TEST(Denoise, FurnaceKeepsItsMean) {
+    auto scene = sceneFromJson(R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_deg": 40,
+        "resolution": [32, 32]}, "media": [{"type": "homogeneous", "sigma_a": 0, "sigma_s": 4, "g": 0.7,
+        "bounds": {"min": [-3, -3, -3], "max": [3, 3, 3]}}], "background": [1, 1, 1],
+        "render": {"method": "reference", "spp": 8, "max_depth": 100000, "seed": 4}})");
+    RenderOptions options;
+    options.keepHalves = true;
+    const RenderResult r = renderImage(*scene, options);
+    DenoiseInput in;
+    in.width = in.height = 32;
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+            in.halfA.push_back(r.evenHalf.rgb(x, y));
+            in.halfB.push_back(r.oddHalf.rgb(x, y));
+        }
+    const Image d = denoise(in);
+    for (int c = 0; c < 3; ++c) {
+        const ChannelStats raw = pixelStats(r.image, c), denoised = pixelStats(d, c);
+        EXPECT_NEAR(raw.mean, 1.0, 4 * raw.stdError + 1e-6);
+        EXPECT_NEAR(denoised.mean, raw.mean, 3 * raw.stdError + 1e-6) << "channel " << c;
     }
 }
 
