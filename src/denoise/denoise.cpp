@@ -690,14 +690,20 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
         // min(colour weight, feature weight) (Rousselle et al. 2013), one
         // exponential of the larger distance.
         const int f = options.patchRadius, radius = options.searchRadius;
+        // The patch distance is the colour's alone; alpha is averaged with
+        // the colour's weights. In a volume, alpha (1 - transmittance) has
+        // strong structure and little noise (the marchers estimate it
+        // smoothly), so a distance that held it rejected nearly every
+        // neighbour: measured on cloud_sun at 16 s, the denoised RMSE was
+        // 0.041 with alpha in the distance and 0.026 without.
         Guide halves;
-        for (int c = 0; c < channels; ++c) {
+        for (int c = 0; c < 3; ++c) {
             halves.values.push_back(&a[size_t(c)]);
             halves.secondValues.push_back(&b[size_t(c)]);
             halves.variances.push_back(&variance[size_t(c)]);
         }
         halves.k2 = options.colorStrength * options.colorStrength;
-        halves.norm = 1.f / float(channels * (2 * f + 1) * (2 * f + 1));
+        halves.norm = 1.f / float(3 * (2 * f + 1) * (2 * f + 1));
 
         forEachTile(w, h, [&](const Rect& tile) {
             const int tw = tile.width(), n = tw * tile.height();

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The denoiser and the noise estimate against the truth, at equal time
+# (docs/denoise.md; BENCHMARKS.md, "Denoising and the noise target").
+# For each scene: a truth (the path tracer, TRUTH_FACTOR x the largest budget,
+# another seed), whose own noise (its two halves' estimate) is subtracted from
+# every MSE; then at each budget the default method raw (--no-denoise) and
+# denoised (--denoise, the denoiser's time counted), each against the truth:
+# RMSE net of the truth's noise, low-frequency error, and the raw render's
+# own noise estimate beside its measured error.
+# Usage: tools/bench_denoise.sh OUT SCENE...   (env: RES 160x120, BUDGETS "16",
+# THREADS 2, TRUTH_FACTOR 8, BIN build/bin/vdbmarch, EXTRA extra render options)
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+OUT="$1"; shift
+BIN="${BIN:-$ROOT/build/bin/vdbmarch}"; RES="${RES:-160x120}"; BUDGETS="${BUDGETS:-16}"
+THREADS="${THREADS:-2}"; TRUTH_FACTOR="${TRUTH_FACTOR:-8}"; EXTRA="${EXTRA:-}"
+mkdir -p "$OUT"
+field() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d'+sys.argv[1]))" "$2"; }
+metric() { "$BIN" compare "$1" "$2" | awk -v k="$3" '$1 == k {print $2}'; }
+echo "| scene | res | budget s | spp | raw RMSE / truth-noise-net | denoised RMSE net | MSE ratio | raw LF | denoised LF | raw noise estimated / measured (rel.) | truth rel. noise | denoise s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+for scene in "$@"; do
+    name=$(basename "$scene" .json)
+    max=0; for b in $BUDGETS; do max=$(python3 -c "print(max($max, $b))"); done
+    truth="$OUT/$name.$RES.truth.exr"
+    if [ ! -f "$truth" ]; then
+        "$BIN" render "$scene" -o "$truth" --res "$RES" --threads "$THREADS" --method reference \
+            --time "$(python3 -c "print($max * $TRUTH_FACTOR)")" --seed 777 --no-denoise -q --stats "$truth.json" $EXTRA
+    fi
+    tn=$(field "$truth.json" "['noise_estimate']['rmse']")
+    tm=$(field "$truth.json" "['noise_estimate']['mean']")
+    for b in $BUDGETS; do
+        raw="$OUT/$name.$RES.$b.raw.exr"; den="$OUT/$name.$RES.$b.den.exr"
+        "$BIN" render "$scene" -o "$raw" --res "$RES" --threads "$THREADS" --time "$b" --seed 11 --no-denoise -q --stats "$raw.json" $EXTRA
+        "$BIN" render "$scene" -o "$den" --res "$RES" --threads "$THREADS" --time "$b" --seed 11 --denoise 2>"$den.log" --stats "$den.json" $EXTRA
+        dsec=$(sed -n 's/.*denoised in \([0-9.]*\) s.*/\1/p' "$den.log")
+        rr=$(metric "$raw" "$truth" rmse); rd=$(metric "$den" "$truth" rmse)
+        lr=$(metric "$raw" "$truth" low_frequency_error); ld=$(metric "$den" "$truth" low_frequency_error)
+        spp=$(field "$raw.json" "['spp']"); est=$(field "$raw.json" "['noise_estimate']['relative']")
+        python3 - "$name" "$RES" "$b" "$spp" "$rr" "$rd" "$tn" "$tm" "$lr" "$ld" "$est" "$dsec" <<'PY'
+import sys, math
+name, res, b, spp, rr, rd, tn, tm, lr, ld, est, dsec = sys.argv[1:]
+rr, rd, tn, tm, lr, ld, est = map(float, (rr, rd, tn, tm, lr, ld, est))
+net = lambda r: math.sqrt(max(0.0, r * r - tn * tn))
+nr, nd = net(rr), net(rd)
+print(f"| {name} | {res} | {b} | {spp} | {rr:.4g} / {nr:.4g} | {nd:.4g} | {nd*nd/(nr*nr):.3f} | {lr:.4f} | {ld:.4f} | "
+      f"{est:.4f} / {nr/tm:.4f} | {tn/tm:.4f} | {dsec} |")
+PY
+    done
+done
