@@ -357,6 +357,45 @@ std::vector<float> channelOf(const std::vector<Color>& v, int c) {
 // Per-pixel variance of one half: E[(A - B)^2] = 2 Var[half] for independent
 // halves of equal variance; (A - B)^2 has one degree of freedom, so it is
 // box-smoothed first (the two-buffer variance of Rousselle et al. 2012).
+// Fireflies: a rare, bright path lands in one half render only, and
+// cross-filtering would spread it over the whole search window of every
+// neighbour (a square blotch), since the other half's patches look normal
+// there. A real feature shows in both halves, so each half is clamped to
+// twice the other half's 3x3 maximum plus the other half's image mean (the
+// floor for dark surroundings). Biased like every firefly clamp, but the
+// bound grows with the other half, so the loss shrinks as samples grow.
+void suppressFireflies(Plane& a, Plane& b) {
+    const int w = a.width, h = a.height;
+    auto mean = [&](const Plane& p) {
+        double sum = 0;  // serial: the same sum for any thread count
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) sum += double(p.at(x, y));
+        return float(sum / std::max(1.0, double(w) * double(h)));
+    };
+    const float meanA = mean(a), meanB = mean(b);
+    auto bounds = [&](const Plane& other, float floor) {
+        Plane bound(w, h, 0);
+        forEachRow(h, [&](int y) {
+            for (int x = 0; x < w; ++x) {
+                float m = 0;
+                for (int j = std::max(0, y - 1); j <= std::min(h - 1, y + 1); ++j)
+                    for (int i = std::max(0, x - 1); i <= std::min(w - 1, x + 1); ++i) m = std::max(m, other.at(i, j));
+                bound.at(x, y) = 2.f * m + std::max(0.f, floor);
+            }
+        });
+        return bound;
+    };
+    const Plane boundA = bounds(b, meanB), boundB = bounds(a, meanA);
+    forEachRow(h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            a.at(x, y) = std::min(a.at(x, y), boundA.at(x, y));
+            b.at(x, y) = std::min(b.at(x, y), boundB.at(x, y));
+        }
+    });
+    a.replicateEdges();
+    b.replicateEdges();
+}
+
 Plane halfVariance(const Plane& a, const Plane& b, int radius) {
     Plane sq(a.width, a.height, a.pad);
     forEachRow(a.height, [&](int y) {
@@ -649,9 +688,10 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
         const size_t planes = static_cast<size_t>(channels);
         std::vector<Plane> a(planes), b(planes), variance(planes);
         for (int c = 0; c < channels; ++c) {
-            if (c < 3)
+            if (c < 3) {
                 loadHalves(channelOf(in.halfA, c), channelOf(in.halfB, c), w, h, pad, a[size_t(c)], b[size_t(c)]);
-            else
+                if (options.suppressFireflies) suppressFireflies(a[size_t(c)], b[size_t(c)]);
+            } else
                 loadHalves(in.alphaA, in.alphaB, w, h, pad, a[3], b[3]);
             variance[size_t(c)] = halfVariance(a[size_t(c)], b[size_t(c)], options.varianceRadius);
         }

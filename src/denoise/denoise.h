@@ -45,6 +45,10 @@ struct DenoiseOptions {
     // noise standard deviations, and tau, the floor of the squared feature
     // difference scale (features are normalised to about [0, 1]).
     bool useFeatures = true;
+    // Clamp each half to twice the other half's 3x3 maximum plus its mean
+    // before filtering: a firefly in one half would otherwise spread over a
+    // search window.
+    bool suppressFireflies = true;
     float featureStrength = 0.6f;
     float featureThreshold = 1e-3f;
     // The features are first denoised by NL-means guided by themselves
