@@ -68,7 +68,9 @@ TEST_F(TilesCli, TilesAreDenoisedAfterMergeLikeOneProcess) {
     // The denoised RGBA is not the noisy one.
     const ExrContents single = readExrContents(work("single.exr"));
     for (const ExrLayer& l : single.layers)
-        if (l.name == "noisy") EXPECT_NE(l.pixels, single.image.rgba);
+        if (l.name == "noisy") {
+            EXPECT_NE(l.pixels, single.image.rgba);
+        }
 
     render("p_single.exr", with(features, {"--png", "p_single.png"}));
     renderTiles(2, features);
