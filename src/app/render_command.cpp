@@ -267,22 +267,22 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (options.keepHalves && r.spp < 2) {
         warn(str("not denoised: the denoiser needs at least 2 samples per pixel (", r.spp, " rendered)"));
     } else if (options.keepHalves) {
-        std::vector<ExrLayer> halves = {rgbaLayer(EvenHalfLayer, r.evenHalf), rgbaLayer(OddHalfLayer, r.oddHalf)};
+        // The halves join the layers, which are the denoiser's input (the
+        // AOV features among them). The EXR keeps them with the denoised
+        // RGBA and the noisy beauty; a tile keeps its noisy RGBA and the
+        // halves for merge; a preview-only EXR drops them again.
+        r.layers.push_back({EvenHalfLayer, {"R", "G", "B", "A"}, std::move(r.evenHalf.rgba)});
+        r.layers.push_back({OddHalfLayer, {"R", "G", "B", "A"}, std::move(r.oddHalf.rgba)});
         if (!tile.any()) {
             const auto d0 = std::chrono::steady_clock::now();
-            std::vector<ExrLayer> inputs = r.layers;
-            inputs.insert(inputs.end(), halves.begin(), halves.end());
-            preview = denoiseFrame(r.image.width, r.image.height, inputs, desc.render.threads);
+            preview = denoiseFrame(r.image.width, r.image.height, r.layers, desc.render.threads);
             denoiseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
-        }
-        // The EXR: the denoised RGBA with the noisy beauty and the halves as
-        // layers; a tile keeps its noisy RGBA and the halves for merge.
-        if (denoiseMode == RenderSettings::Denoise::On || tile.any()) {
-            if (!tile.any()) {
+            if (denoiseMode == RenderSettings::Denoise::On) {
                 r.layers.push_back(rgbaLayer(NoisyLayer, r.image));
                 r.image = preview;
+            } else {
+                r.layers.resize(r.layers.size() - 2);
             }
-            r.layers.insert(r.layers.end(), halves.begin(), halves.end());
         }
     }
     if (desc.frame) attrs.emplace_back("vdbmarch:frame", std::to_string(*desc.frame));

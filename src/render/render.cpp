@@ -84,11 +84,7 @@ int nextNoiseCheck(int n) {
     while (c <= n) c = std::max(c + 4, (c * 5 + 3) / 4);
     return c;
 }
-bool isNoiseCheck(int n) {
-    int c = 16;
-    while (c < n) c = std::max(c + 4, (c * 5 + 3) / 4);
-    return c == n;
-}
+bool isNoiseCheck(int n) { return n >= 16 && nextNoiseCheck(n - 1) == n; }
 
 // Random stream of the feature AOVs, apart from the beauty's.
 constexpr uint64_t AovStream = 0x616f7673;
@@ -184,25 +180,38 @@ bool pixelNoise(const Color& L, const Color& oddL, int first, int n, Color& mean
     return true;
 }
 
+// The image's NoiseEstimate from its pixels' means and variances, RGB summed.
+struct NoiseTotals {
+    double variance = 0, mean = 0;
+    size_t pixels = 0;
+    void add(const Color& m, const Color& v) {
+        variance += double(v.x) + double(v.y) + double(v.z);
+        mean += double(m.x) + double(m.y) + double(m.z);
+        ++pixels;
+    }
+    NoiseEstimate estimate() const {
+        NoiseEstimate e;
+        const double n = 3.0 * double(std::max<size_t>(1, pixels));
+        e.valid = pixels > 0;
+        e.rmse = std::sqrt(variance / n);
+        e.mean = mean / n;
+        return e;
+    }
+};
+
 }  // namespace
 
 Image PixelSums::evenHalf(int width, int height) const { return halfImage(*this, width, height, false); }
 Image PixelSums::oddHalf(int width, int height) const { return halfImage(*this, width, height, true); }
 
-NoiseEstimate estimateNoise(const PixelSums& sums) {
-    NoiseEstimate e;
-    double sumVar = 0, sumMean = 0;
+NoiseEstimate estimateNoise(const PixelSums& sums, int firstSample) {
+    NoiseTotals totals;
     for (size_t p = 0; p < sums.L.size(); ++p) {
         Color mean, var;
-        if (!pixelNoise(sums.L[p], sums.oddL[p], 0, sums.samplesOf(p), mean, var)) return e;
-        sumVar += double(var.x) + double(var.y) + double(var.z);
-        sumMean += double(mean.x) + double(mean.y) + double(mean.z);
+        if (!pixelNoise(sums.L[p], sums.oddL[p], firstSample, sums.samplesOf(p), mean, var)) return {};
+        totals.add(mean, var);
     }
-    const double n = 3.0 * double(std::max<size_t>(1, sums.L.size()));
-    e.valid = !sums.L.empty();
-    e.rmse = std::sqrt(sumVar / n);
-    e.mean = sumMean / n;
-    return e;
+    return totals.estimate();
 }
 
 PixelRect tileOfFrame(int index, int count, int width, int height) {
@@ -478,7 +487,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     auto checkNoise = [&](int n) {
         if (!adaptive || !isNoiseCheck(n)) return false;
         std::vector<float> perSample(pixels);  // variance of one sample, RGB summed
-        double sumVar = 0, sumMean = 0;
+        NoiseTotals totals;
         for (size_t p = 0; p < pixels; ++p) {
             Color L = sums.L[p], odd = sums.oddL[p], mean, var;
             if (open.pass >= 0) {
@@ -487,13 +496,12 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             }
             const int k = sums.convergedAt[p] > 0 ? sums.convergedAt[p] : n;
             if (!pixelNoise(L, odd, 0, k, mean, var)) return false;
-            const double v = double(var.x) + double(var.y) + double(var.z);
-            perSample[p] = float(v * k);
-            sumVar += v;
-            sumMean += double(mean.x) + double(mean.y) + double(mean.z);
+            perSample[p] = float((double(var.x) + double(var.y) + double(var.z)) * k);
+            totals.add(mean, var);
         }
-        const double target = double(rs.noise) * sumMean / double(3 * pixels);
-        if (std::sqrt(sumVar / double(3 * pixels)) <= target) return reachedTarget = true;
+        const NoiseEstimate image = totals.estimate();
+        const double target = double(rs.noise) * image.mean;
+        if (image.rmse <= target) return reachedTarget = true;
         // s_b per block, and k from their pixel-weighted mean.
         const int bx = (ww + NoiseBlock - 1) / NoiseBlock, by = (wh + NoiseBlock - 1) / NoiseBlock;
         std::vector<double> sigma(size_t(bx) * size_t(by), 0.0);
@@ -583,7 +591,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     closePass();
     result.image = sums.average(ww, wh);
     result.layers = aovLayers(aovs, aovSums, sums);
-    result.noise = estimateNoise(sums);
+    result.noise = estimateNoise(sums, first);
     result.reachedNoiseTarget = reachedTarget;
     double sampled = 0;
     for (size_t p = 0; p < pixels; ++p) sampled += sums.samplesOf(p);

@@ -117,7 +117,9 @@ struct NoiseEstimate {
     double mean = 0;     // mean of the RGB
     double relative() const { return mean > 0 ? rmse / mean : 0.0; }
 };
-NoiseEstimate estimateNoise(const PixelSums& sums);
+// `firstSample`: the index of the sums' first sample (a part by photon
+// passes starts mid-render), which says which samples are the odd ones.
+NoiseEstimate estimateNoise(const PixelSums& sums, int firstSample = 0);
 
 // The AOVs' per-pixel sums (only those render.aovs asks for are allocated).
 struct AovSums {
