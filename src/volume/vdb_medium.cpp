@@ -20,6 +20,7 @@
 #include "core/memory.h"
 #include "core/transform.h"
 #include "volume/medium.h"
+#include "volume/padded_blocks.h"
 #include "volume/vdb_io.h"
 
 namespace vdbmarch {
@@ -229,95 +230,6 @@ inline float sampleTrilinear(openvdb::FloatGrid::ConstAccessor& acc, const openv
     return b0 + (b1 - b0) * tx;
 }
 
-// Density copied into padded 9x9x9 blocks, one per 8x8x8 leaf-aligned block
-// where samples can land: every trilinear lookup then reads its eight corners
-// from one contiguous block, with no tree traversal while a ray stays inside
-// the block (a step of one voxel stays ~8 samples in a block).
-struct PaddedBlocks {
-    static constexpr int N = 9, Size = N * N * N;
-    std::vector<float> values;   // Size floats per block
-    openvdb::Int32Tree index{0};  // at each block origin: block id + 1; 0 = empty
-    // Per block, the cells (0..7 per axis) whose trilinear stencil touches a
-    // non-zero value: lo in bits 0-11, hi (exclusive, 1..8) in bits 12-23.
-    std::vector<uint32_t> tightBox;
-    std::vector<float> blockMax;  // largest value in each padded block: a local majorant
-    // Smallest value in each padded block: every trilinear value inside the
-    // block's cells is a convex combination of them, so at least this.
-    std::vector<float> blockMin;
-
-    static uint32_t computeTightBox(const float* v) {
-        int lo[3] = {8, 8, 8}, hi[3] = {0, 0, 0};
-        for (int x = 0; x < 8; ++x)
-            for (int y = 0; y < 8; ++y)
-                for (int z = 0; z < 8; ++z) {
-                    bool nonZero = false;
-                    for (int c = 0; c < 8 && !nonZero; ++c)
-                        nonZero = v[((x + (c >> 2)) * N + y + ((c >> 1) & 1)) * N + z + (c & 1)] != 0;
-                    if (!nonZero) continue;
-                    int p[3] = {x, y, z};
-                    for (int a = 0; a < 3; ++a) {
-                        lo[a] = std::min(lo[a], p[a]);
-                        hi[a] = std::max(hi[a], p[a] + 1);
-                    }
-                }
-        uint32_t packed = 0;
-        for (int a = 0; a < 3; ++a) packed |= uint32_t(lo[a]) << (4 * a) | uint32_t(hi[a]) << (12 + 4 * a);
-        return packed;
-    }
-
-    void build(const openvdb::FloatGrid& grid, const BoolTree& topology) {
-        std::vector<openvdb::Coord> origins;
-        for (auto leaf = topology.cbeginLeaf(); leaf; ++leaf) origins.push_back(leaf->origin());
-        // Active tiles of the topology (coarse constant regions) hold blocks too.
-        for (auto it = topology.cbeginValueOn(); it; ++it) {
-            if (it.isVoxelValue()) continue;
-            openvdb::CoordBBox b = it.getBoundingBox();
-            for (int x = b.min().x(); x <= b.max().x(); x += 8)
-                for (int y = b.min().y(); y <= b.max().y(); y += 8)
-                    for (int z = b.min().z(); z <= b.max().z(); z += 8) origins.emplace_back(x, y, z);
-        }
-        std::sort(origins.begin(), origins.end());
-        origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
-        values.assign(origins.size() * Size, 0.f);
-        std::vector<char> nonEmpty(origins.size(), 0);
-        std::vector<uint32_t> boxes(origins.size(), 0);
-        std::vector<float> maxima(origins.size(), 0.f), minima(origins.size(), 0.f);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, origins.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-            auto acc = grid.getConstAccessor();
-            for (size_t b = r.begin(); b != r.end(); ++b) {
-                float* dst = &values[b * Size];
-                const openvdb::Coord o = origins[b];
-                bool any = false;
-                for (int x = 0; x < N; ++x)
-                    for (int y = 0; y < N; ++y)
-                        for (int z = 0; z < N; ++z) {
-                            float v = acc.getValue(o.offsetBy(x, y, z));
-                            dst[(x * N + y) * N + z] = v;
-                            any = any || v != 0;
-                        }
-                nonEmpty[b] = any;
-                if (any) boxes[b] = computeTightBox(dst);
-                const auto range = std::minmax_element(dst, dst + Size);
-                minima[b] = std::max(0.f, *range.first);
-                maxima[b] = *range.second;
-            }
-        });
-        // Compact: drop all-zero blocks.
-        size_t kept = 0;
-        for (size_t b = 0; b < origins.size(); ++b) {
-            if (!nonEmpty[b]) continue;
-            if (kept != b) std::copy_n(&values[b * Size], Size, &values[kept * Size]);
-            index.setValue(origins[b], int32_t(kept + 1));
-            tightBox.push_back(boxes[b]);
-            blockMax.push_back(maxima[b]);
-            blockMin.push_back(minima[b]);
-            ++kept;
-        }
-        values.resize(kept * Size);
-        values.shrink_to_fit();
-    }
-};
-
 class VdbMedium;
 
 class VdbQuery final : public MediumQuery {
@@ -337,12 +249,13 @@ private:
 
     const VdbMedium& mMedium;
     std::unique_ptr<openvdb::FloatGrid::ConstAccessor> mEmission;
-    openvdb::tree::ValueAccessor<const BoolTree> mTopology;
     openvdb::tree::ValueAccessor<const openvdb::Int32Tree> mBlockIndex;
     const float* mBlock = nullptr;            // cached block for mBlockOrigin
     openvdb::Coord mBlockOrigin{INT32_MIN, 0, 0};
-    // Starts at the root's children and descends: large empty nodes are skipped whole.
-    openvdb::math::VolumeHDDA<BoolTree, VdbRay, BoolTree::RootNodeType::ChildNodeType::LEVEL> mHdda;
+    // Walks the block index's tiles, starting at the root's children and
+    // descending: large empty nodes are skipped whole.
+    openvdb::math::VolumeHDDA<openvdb::Int32Tree, VdbRay, openvdb::Int32Tree::RootNodeType::ChildNodeType::LEVEL>
+        mHdda;
     std::vector<VdbRay::TimeSpan> mSpans;
 };
 
@@ -380,17 +293,15 @@ public:
             warn(str(what, " has no active voxels with density > 0: the medium is empty"));
             mMaxDensity = 0;
         }
-        // Topology dilated by one voxel in all 26 directions: trilinear
-        // lookups reach the +1 neighbours, so a point is non-empty iff its
-        // floor voxel is active in the dilated tree.
-        mTopology = std::make_unique<BoolTree>(mDensity->tree(), false, openvdb::TopologyCopy());
-        openvdb::tools::dilateActiveValues(*mTopology, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                           openvdb::tools::IGNORE_TILES);
-        openvdb::CoordBBox ib;
-        mTopology->evalActiveVoxelBoundingBox(ib);
-        mIndexLo = openvdb::Vec3d(ib.min().x(), ib.min().y(), ib.min().z());
-        mIndexHi = openvdb::Vec3d(ib.max().x() + 1, ib.max().y() + 1, ib.max().z() + 1);
-        if (mMaxDensity > 0) mBlocks.build(*mDensity, *mTopology);
+        // The padded blocks answer every density lookup: the grid's leaves
+        // are freed while they are built, and the grid is dropped.
+        if (mMaxDensity > 0) {
+            mBlocks.build(*mDensity);
+            const openvdb::CoordBBox& ib = mBlocks.activeBounds;
+            mIndexLo = openvdb::Vec3d(ib.min().x(), ib.min().y(), ib.min().z());
+            mIndexHi = openvdb::Vec3d(ib.max().x() + 1, ib.max().y() + 1, ib.max().z() + 1);
+        }
+        mDensity.reset();
         if (mMaxDensity > 0)
             for (int i = 0; i < 8; ++i) {
                 Vec3 corner(float(i & 1 ? mIndexHi.x() : mIndexLo.x()), float(i & 2 ? mIndexHi.y() : mIndexLo.y()),
@@ -424,11 +335,11 @@ private:
     friend class VdbQuery;
     friend class VdbEmissionSampler;
     Mat4 mI2W = Mat4::identity(), mEmissionI2W = Mat4::identity();
-    openvdb::FloatGrid::Ptr mDensity, mEmissionGrid;
-    std::unique_ptr<BoolTree> mTopology;
+    openvdb::FloatGrid::Ptr mDensity;  // only while loading
+    openvdb::FloatGrid::Ptr mEmissionGrid;
     PaddedBlocks mBlocks;
     Affine mW2I, mEmissionW2I;
-    openvdb::Vec3d mIndexLo, mIndexHi;
+    openvdb::Vec3d mIndexLo{0, 0, 0}, mIndexHi{0, 0, 0};
     BBox mWorldBounds;
     float mScale = 1, mEmissionScale = 0, mMinVoxel = 0, mMaxDensity = 0;
     size_t mActiveVoxels = 0;
@@ -472,7 +383,7 @@ public:
         openvdb::tools::dilateActiveValues(topology, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
                                            openvdb::tools::EXPAND_TILES);
         auto acc = grid.getConstAccessor();
-        auto dens = m.mDensity->getConstAccessor();
+        VdbQuery density(m);
         mVoxelVolume = float(std::fabs(mI2W.det3()));
         double total = 0, estimate = 0, colour[3] = {0, 0, 0};
         for (auto it = topology.cbeginValueOn(); it; ++it) {
@@ -489,7 +400,7 @@ public:
             // Density at the cell centre, for the power estimate only.
             openvdb::Vec3d centre(c.x() + 0.5, c.y() + 0.5, c.z() + 0.5);
             Vec3 wc = mI2W.point(centre.x(), centre.y(), centre.z());
-            float rho = sampleTrilinear(dens, m.mW2I.point(wc)) * m.mScale;
+            const float rho = density.density(wc);
             const float e = sampleTrilinear(acc, centre);
             estimate += double(rho) * e;
             if (m.blackbody) {
@@ -533,7 +444,7 @@ std::unique_ptr<EmissionSampler> VdbMedium::makeEmissionSampler() const {
 }
 
 VdbQuery::VdbQuery(const VdbMedium& m)
-    : mMedium(m), mTopology(*m.mTopology), mBlockIndex(m.mBlocks.index) {
+    : mMedium(m), mBlockIndex(m.mBlocks.index) {
     if (m.mEmissionGrid) mEmission = std::make_unique<openvdb::FloatGrid::ConstAccessor>(m.mEmissionGrid->getConstAccessor());
 }
 
@@ -551,7 +462,7 @@ float VdbQuery::density(const Vec3& p) {
     if (origin != mBlockOrigin) {
         mBlockOrigin = origin;
         int32_t id = mBlockIndex.getValue(origin);
-        mBlock = id > 0 ? &mMedium.mBlocks.values[size_t(id - 1) * PaddedBlocks::Size] : nullptr;
+        mBlock = id > 0 ? mMedium.mBlocks.block(id) : nullptr;
     }
     if (!mBlock) return 0.f;
     const float tx = float(q.x() - fx), ty = float(q.y() - fy), tz = float(q.z() - fz);
@@ -592,7 +503,7 @@ void VdbQuery::walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit) {
     for (int a = 0; a < 3; ++a)
         if (dir[a] == 0) dir[a] = 1e-30;
     VdbRay ray(eye, dir, t0, t1);
-    mHdda.hits(ray, mTopology, mSpans);
+    mHdda.hits(ray, mBlockIndex, mSpans);
     // The hierarchical DDA finds spans of leaf-sized blocks; within them walk
     // the blocks with a 3D-DDA on the 8-voxel lattice and keep only the part
     // of the ray inside each block's tight box of non-zero stencils.

@@ -1,0 +1,58 @@
+// Internal to src/volume: a density grid copied into padded 9x9x9 blocks, one
+// per 8x8x8 leaf-aligned block where trilinear samples can land. Every lookup
+// reads its eight corners from one contiguous block, with no tree traversal
+// while a ray stays inside it (a step of one voxel stays ~8 samples in a
+// block). The blocks answer every lookup, so the grid they are built from is
+// not kept: build() frees its leaves as it goes, and the peak memory of a load
+// is about the larger of the grid and the blocks, not their sum.
+// Includes OpenVDB; never include it outside volume/.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <openvdb/openvdb.h>
+
+namespace vdbmarch {
+
+struct PaddedBlocks {
+    static constexpr int N = 9, Size = N * N * N;
+
+    // One level-1 tile (an 8^3 block) per block of the grid's topology dilated
+    // by one voxel (trilinear lookups reach the +1 neighbours): block id + 1
+    // where the padded values are not all zero, 0 where they are. Every tile is
+    // active, so OpenVDB's hierarchical DDA walks exactly these blocks; tiles
+    // cost no leaf (an Int32 leaf per block weighed as much as the grid).
+    openvdb::Int32Tree index{0};
+    // Per block id: its Size values (x-major, z fastest), the cells (0..7 per
+    // axis) whose trilinear stencil touches a non-zero value (lo in bits 0-11,
+    // hi exclusive in bits 12-23), and the largest and smallest value in its
+    // padded block: every trilinear value inside the cells lies between them,
+    // so they are a local majorant and a residual-tracking control.
+    std::vector<const float*> blockValues;
+    std::vector<uint32_t> tightBox;
+    std::vector<float> blockMax, blockMin;
+    // Bounding box of the dilated topology's active voxels (index space).
+    openvdb::CoordBBox activeBounds;
+
+    // Builds the blocks from `grid` (sanitised: inactive values are 0) and
+    // frees the grid's leaves on the way (the grid keeps its tiles and
+    // interior nodes; drop it afterwards). Values are bit-identical to
+    // reading the grid with an accessor; the result is the same for any
+    // thread count.
+    void build(openvdb::FloatGrid& grid);
+
+    const float* block(int32_t id) const { return blockValues[size_t(id - 1)]; }
+    size_t blockCount() const { return blockValues.size(); }
+    // Memory held: block values, per-block tables and the index tree.
+    uint64_t memoryBytes() const;
+
+private:
+    // Block values, one allocation per x slab of blocks (the order they are
+    // built in).
+    std::vector<std::unique_ptr<float[]>> mSlabs;
+    uint64_t mValueBytes = 0;
+};
+
+}  // namespace vdbmarch
