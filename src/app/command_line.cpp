@@ -52,19 +52,16 @@ std::vector<double> parseNumberList(const std::string& s, const std::string& opt
 
 SceneDesc loadSceneInput(const std::string& input, const std::vector<std::string>& overrides,
                          std::optional<int> frame) {
-    // Every VDB file is read once in a child process before this one opens
-    // it (app/vdb_check.h): a damaged file is an error, never a crash.
+    // VDB files are read once, guarded (volume/vdb_read_guard.h): a damaged
+    // file is an error naming it, never a crash.
     if (endsWith(input, ".vdb")) {
         if (!frame && hasFrameToken(input))
             throw InputError(str(input, ": the input holds the frame token (a run of '#'): render it with --frames "
                                         "(e.g. --frames 1-100) to replace the token by each frame's number"));
         const std::string path = frame ? substituteFrame(input, *frame) : input;
-        checkVdbFilesIsolated({path});
         return loadAutoScene(path, overrides, frame);
     }
-    SceneDesc desc = loadSceneFile(input, overrides, frame);
-    checkVdbFilesIsolated(vdbFilesOf(desc));
-    return desc;
+    return loadSceneFile(input, overrides, frame);
 }
 
 void checkFrameOutputs(const std::vector<std::pair<std::string, std::string>>& outputs, size_t frameCount,

@@ -13,7 +13,6 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
-#include <set>
 #include <vector>
 
 #include "core/error.h"
@@ -47,30 +46,6 @@ std::string lastLine(const std::string& text) {
 }
 
 }  // namespace
-
-double vdbCheckTimeout(uint64_t bytes, double readBytesPerSecond) {
-    const double decode = double(bytes) / 20e6;
-    const double read = readBytesPerSecond > 0 ? double(bytes) / readBytesPerSecond : 0.0;
-    return 8 + decode + 10 * read;
-}
-
-double measureReadSpeed(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return 0;
-    constexpr size_t Limit = size_t(64) << 20, Chunk = size_t(1) << 20;
-    std::vector<char> buf(Chunk);
-    size_t total = 0;
-    const auto start = std::chrono::steady_clock::now();
-    while (total < Limit) {
-        const ssize_t got = ::read(fd, buf.data(), Chunk);
-        if (got < 0 && errno == EINTR) continue;
-        if (got <= 0) break;
-        total += size_t(got);
-    }
-    ::close(fd);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return total == 0 ? 0.0 : double(total) / std::max(seconds, 1e-6);
-}
 
 void checkVdbFileIsolated(const std::string& path, double timeoutSeconds) {
     struct stat st;
@@ -132,19 +107,6 @@ void checkVdbFileIsolated(const std::string& path, double timeoutSeconds) {
         // The child's message already names the file.
         throw InputError(why.find(path) != std::string::npos ? why : str(path, ": ", why));
     }
-}
-
-std::vector<std::string> vdbFilesOf(const SceneDesc& desc) {
-    std::vector<std::string> files;
-    std::set<std::string> seen;
-    auto add = [&](const std::string& f) {
-        if (!f.empty() && seen.insert(f).second) files.push_back(f);
-    };
-    for (const MediumDesc& m : desc.media)
-        if (m.type == MediumDesc::Type::Vdb) add(m.file);
-    for (const SurfaceDesc& s : desc.surfaces)
-        if (s.shape == SurfaceDesc::Shape::VdbIsosurface) add(s.file);
-    return files;
 }
 
 void setVdbCheckExecutable(const std::string& path) { checkExecutable() = path; }

@@ -21,6 +21,7 @@
 #include "core/transform.h"
 #include "volume/medium.h"
 #include "volume/padded_blocks.h"
+#include "volume/vdb_read_guard.h"
 #include "volume/vdb_io.h"
 
 namespace vdbmarch {
@@ -267,6 +268,9 @@ public:
         sigma_s = d.sigma_s;
         g = d.g;
         const std::string what = str(d.file, ": grid '", d.grid, "'");
+        // Guards the read and everything that walks or frees what it built:
+        // heap damage from a bad file shows there, when glibc checks a free.
+        const auto guard = guardVdbRead(d.file);
         mDensity = readFloatGrid(d.file, d.grid);
         sanitize(*mDensity, what);
         mScale = d.densityScale;
@@ -587,6 +591,7 @@ void VdbQuery::forEachMajorant(const Ray& r, float tMin, float tMax,
 // Picks the grid by name; with an empty name prefers "density", else the first
 // scalar grid. Reads it and returns it as a float grid.
 openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string& wanted, std::string* chosenName) {
+    const auto guard = guardVdbRead(path);
     auto file = openVdbFile(path);
     std::string name = wanted;
     if (name.empty()) {
@@ -684,6 +689,7 @@ std::vector<std::string> listVdbGrids(const std::string& path) {
 }
 
 size_t readEveryGrid(const std::string& path) {
+    const auto guard = guardVdbRead(path);
     auto file = openVdbFile(path);
     size_t voxels = 0;
     for (auto name = file->beginName(); name != file->endName(); ++name) {
