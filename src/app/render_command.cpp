@@ -14,6 +14,7 @@
 #include "app/tiles.h"
 #include "app/vdb_check.h"
 #include "core/atomic_file.h"
+#include "core/memory.h"
 #include "image/exr_io.h"
 #include "image/png_io.h"
 #include "parse/frames.h"
@@ -22,6 +23,7 @@
 #include "render/checkpoint.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "volume/medium.h"
 
 namespace vdbmarch {
 
@@ -120,9 +122,28 @@ void validate(const RenderArgs& a) {
     parseTileRequest(a.tile, a.crop, a.passes);
 }
 
+// The render's peak memory, predicted before any volume is read from what
+// the process holds now, each medium's load (volume/medium.h) and the image;
+// photons and the cache are checked where they are made (docs/memory.md).
+// Refuses a render that cannot fit; returns the prediction.
+uint64_t checkRenderMemory(const SceneDesc& desc, const PixelRect& window) {
+    uint64_t held = residentMemoryBytes(), peak = held, media = 0;
+    for (const MediumDesc& m : desc.media) {
+        const MediumMemory need = predictMediumMemory(m);
+        peak = std::max(peak, held + need.loading);
+        held += need.resident;
+        media += need.resident;
+    }
+    const uint64_t image = imageMemoryBytes(window.width(), window.height(), desc.render.aovs);
+    peak = std::max(peak, held + image);
+    checkMemory(peak, str("this render (media ", formatBytes(media), " once loaded, image ", formatBytes(image),
+                          ", with the grids' loading peak and what the process holds)"));
+    return peak;
+}
+
 // Timings, counts and counters of a finished render (--stats).
 std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& scene, const RenderResult& r,
-                      double loadSeconds, double total) {
+                      double loadSeconds, double total, uint64_t predictedMemory) {
     const RenderCounters& c = r.counters;
     nlohmann::json s;
     s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"photons_and_cache", r.illuminationSeconds},
@@ -140,6 +161,10 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     if (desc.render.noise > 0) s["noise_target"] = {{"target", desc.render.noise}, {"reached", r.reachedNoiseTarget}};
     if (a.timeBudget) s["time_budget"] = *a.timeBudget;
     s["resolution"] = {r.image.width, r.image.height};
+    s["memory"] = {{"predicted_peak_bytes", predictedMemory},
+                   {"peak_bytes", peakResidentMemoryBytes()},
+                   {"photon_bytes", r.photonBytes},
+                   {"cache_bytes", r.cacheBytes}};
     s["step"] = scene.step;
     s["shadow_step"] = scene.shadowStep;
     s["counters"] = {{"camera_rays", c.cameraRays},         {"surface_hits", c.surfaceHits},
@@ -180,6 +205,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     const TileRequest tile = parseTileRequest(a.tile, a.crop, a.passes);
     const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
     checkImageMemory(window.width(), window.height(), desc.render.aovs);  // before any volume is loaded
+    const uint64_t predictedMemory = checkRenderMemory(desc, window);
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -294,7 +320,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
     if (!a.png.empty()) writePng(a.png, preview, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total));
+    if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total, predictedMemory));
     if (!checkpointPath.empty() && !a.keepCheckpoint) std::remove(checkpointPath.c_str());  // the render is whole
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s%s\n",

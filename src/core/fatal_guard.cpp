@@ -96,15 +96,6 @@ void onSanitizerDeath() {
 
 }  // namespace
 
-uint64_t residentMemoryBytes() {
-    std::FILE* f = std::fopen("/proc/self/statm", "r");
-    if (!f) return 0;
-    unsigned long long size = 0, resident = 0;
-    const int got = std::fscanf(f, "%llu %llu", &size, &resident);
-    std::fclose(f);
-    return got == 2 ? uint64_t(resident) * uint64_t(::sysconf(_SC_PAGESIZE)) : 0;
-}
-
 bool FatalGuard::active() { return gGuardActive.load(); }
 
 FatalGuard::FatalGuard(const std::string& what, double seconds, uint64_t memoryGrowth) {

@@ -38,7 +38,4 @@ private:
     std::thread mWatchdog;
 };
 
-// Resident memory of this process (bytes; 0 where /proc is not readable).
-uint64_t residentMemoryBytes();
-
 }  // namespace vdbmarch

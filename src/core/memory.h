@@ -16,6 +16,11 @@ uint64_t availableMemoryBytes();
 // GiB") when `bytes` exceeds the available memory.
 void checkMemory(uint64_t bytes, const std::string& what);
 
+// Resident memory of this process now, and its peak so far (VmHWM), in bytes;
+// 0 where /proc is not readable.
+uint64_t residentMemoryBytes();
+uint64_t peakResidentMemoryBytes();
+
 // "12.3 GiB", "456 MiB".
 std::string formatBytes(uint64_t bytes);
 

@@ -224,12 +224,16 @@ PixelRect tileOfFrame(int index, int count, int width, int height) {
     return {0, row(index), width, row(index + 1)};
 }
 
-void checkImageMemory(int width, int height, const AovSet& aovs) {
+uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs) {
     // The totals, the open pass's sums, the RGBA result and the AOVs.
     // Each twice: all samples and the odd-index half.
     const uint64_t perPixel = 2 * (sizeof(Color) + sizeof(ColorSum) + 2 * sizeof(double)) + 4 * sizeof(float) +
                               sizeof(int) + AovSums::bytesPerPixel(aovs);
-    checkMemory(uint64_t(width) * uint64_t(height) * perPixel,
+    return uint64_t(width) * uint64_t(height) * perPixel;
+}
+
+void checkImageMemory(int width, int height, const AovSet& aovs) {
+    checkMemory(imageMemoryBytes(width, height, aovs),
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
 
@@ -310,6 +314,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     });
     const double firstIlluminationSeconds = illumination->stats.seconds;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
+    result.photonBytes = illumination->stats.photonBytes;
+    result.cacheBytes = illumination->stats.cacheBytes;
 
     // A resumed render takes the checkpoint's sums, counters and time; the
     // photon passes are replayed from their seeds when the next sample needs

@@ -153,6 +153,7 @@ struct RenderResult {
     double seconds = 0;   // photons, cache and rendering
     double illuminationSeconds = 0;  // photon tracing and cache (part of seconds)
     size_t photons = 0, cacheCells = 0;
+    size_t photonBytes = 0, cacheBytes = 0;  // the photon maps and the cache held
     int threads = 0;      // worker threads used
     int spp = 0;          // samples per pixel actually rendered (the most any pixel got)
     double meanSpp = 0;   // averaged over the pixels (below spp with adaptive sampling)
@@ -180,6 +181,8 @@ constexpr float NoDepth = 1e10f;
 // not fit in this machine's memory: per pixel the sums (PixelSums and the
 // open pass's), the RGBA result, and the sums and layers of the AOVs.
 void checkImageMemory(int width, int height, const AovSet& aovs = {});
+// The bytes checkImageMemory checks.
+uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs = {});
 
 // Tile `index` of `count` of a width x height frame: horizontal bands of
 // whole rows (the unit an EXR scanline file stores), rows

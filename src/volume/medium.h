@@ -110,6 +110,16 @@ std::unique_ptr<Medium> makeHomogeneousMedium(const MediumDesc& desc);
 // Loads the VDB file; throws InputError naming the file and grid on failure.
 std::unique_ptr<Medium> loadVdbMedium(const MediumDesc& desc);
 
+// Memory a medium takes, predicted from its VDB grids' metadata before any
+// value is read (docs/memory.md: the formula and its measured accuracy); all
+// zero for homogeneous media and files without the metadata.
+struct MediumMemory {
+    uint64_t gridBytes = 0;  // the density grid as OpenVDB holds it
+    uint64_t loading = 0;    // peak while it loads, above what the process held
+    uint64_t resident = 0;   // held afterwards, while rendering
+};
+MediumMemory predictMediumMemory(const MediumDesc& desc);
+
 // Summary of a VDB grid, used to build a scene for a bare .vdb file.
 struct VdbGridSummary {
     std::string gridName;

@@ -1,13 +1,16 @@
 #include "volume/padded_blocks.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
+#include <new>
+
+#include <sys/mman.h>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
 
-#include <openvdb/tools/Morphology.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -18,26 +21,75 @@ namespace {
 using LeafT = openvdb::FloatTree::LeafNodeType;
 using openvdb::Coord;
 
+// For each of the 26 neighbouring leaves, the voxels of a leaf whose
+// 26-neighbourhood reaches into it (x = 7 towards +x, x = 0 towards -x,
+// any x where the step in x is 0; the same in y and z).
+struct NeighbourReach {
+    Coord step;
+    LeafT::NodeMaskType voxels;
+};
+
+std::vector<NeighbourReach> neighbourReaches() {
+    std::vector<NeighbourReach> out;
+    for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz) {
+                if (dx == 0 && dy == 0 && dz == 0) continue;
+                NeighbourReach n{Coord(dx, dy, dz), LeafT::NodeMaskType()};
+                auto reaches = [](int d, int v) { return d == 0 || (d > 0 ? v == 7 : v == 0); };
+                for (openvdb::Index i = 0; i < LeafT::SIZE; ++i) {
+                    const Coord v = LeafT::offsetToLocalCoord(i);
+                    if (reaches(dx, v.x()) && reaches(dy, v.y()) && reaches(dz, v.z())) n.voxels.setOn(i);
+                }
+                out.push_back(n);
+            }
+    return out;
+}
+
 // Origins of the 8^3 blocks of the grid's active topology dilated by one voxel
 // in all 26 directions (a point is non-empty iff its floor voxel is active
-// there), sorted x-major; `bounds` gets the dilated active voxels' box.
+// there), sorted x-major; `bounds` gets the dilated active voxels' box. As
+// OpenVDB's dilateActiveValues with IGNORE_TILES on a topology copy: every
+// leaf, the neighbours its active voxels reach, and the blocks of active
+// tiles (tiles are not dilated); done on the leaves' masks, in a tree with one
+// voxel per block, without building the dilated tree.
 std::vector<Coord> dilatedBlockOrigins(const openvdb::FloatTree& tree, openvdb::CoordBBox& bounds) {
-    openvdb::BoolTree topology(tree, false, openvdb::TopologyCopy());
-    openvdb::tools::dilateActiveValues(topology, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
-    topology.evalActiveVoxelBoundingBox(bounds);
+    static const std::vector<NeighbourReach> reaches = neighbourReaches();
+    openvdb::BoolTree blocks(false);
+    openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(blocks);
+    bounds = openvdb::CoordBBox();
+    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+        const Coord b = leaf->origin() >> 3;
+        acc.setValueOn(b);
+        const auto& on = leaf->getValueMask();
+        if (on.isOff()) continue;
+        openvdb::CoordBBox box;
+        leaf->evalActiveBoundingBox(box, /*visitVoxels=*/true);
+        box.expand(1);
+        bounds.expand(box);
+        for (const NeighbourReach& n : reaches) {
+            LeafT::NodeMaskType hit = on;
+            hit &= n.voxels;
+            if (!hit.isOff()) acc.setValueOn(b + n.step);
+        }
+    }
+    // Active tiles: the interior nodes' values only (the leaves' voxels are done).
+    auto tile = tree.cbeginValueOn();
+    tile.setMaxDepth(openvdb::FloatTree::DEPTH - 2);
+    for (; tile; ++tile) {
+        const openvdb::CoordBBox box = tile.getBoundingBox();
+        bounds.expand(box);
+        for (int x = box.min().x(); x <= box.max().x(); x += 8)
+            for (int y = box.min().y(); y <= box.max().y(); y += 8)
+                for (int z = box.min().z(); z <= box.max().z(); z += 8) acc.setValueOn(Coord(x, y, z) >> 3);
+    }
     std::vector<Coord> origins;
-    for (auto leaf = topology.cbeginLeaf(); leaf; ++leaf) origins.push_back(leaf->origin());
-    // Active tiles of the topology (coarse constant regions) hold blocks too.
-    for (auto it = topology.cbeginValueOn(); it; ++it) {
-        if (it.isVoxelValue()) continue;
-        const openvdb::CoordBBox b = it.getBoundingBox();
-        for (int x = b.min().x(); x <= b.max().x(); x += 8)
-            for (int y = b.min().y(); y <= b.max().y(); y += 8)
-                for (int z = b.min().z(); z <= b.max().z(); z += 8) origins.emplace_back(x, y, z);
+    origins.reserve(size_t(blocks.activeVoxelCount()));
+    for (auto it = blocks.cbeginValueOn(); it; ++it) {
+        const Coord b = it.getCoord();
+        origins.emplace_back(b.x() * 8, b.y() * 8, b.z() * 8);
     }
     std::sort(origins.begin(), origins.end());
-    origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
     return origins;
 }
 
@@ -54,34 +106,58 @@ void readPadded(openvdb::FloatGrid::ConstAccessor& acc, const Coord& o, float* d
         leaf[i] = l ? l->buffer().data() : nullptr;
         tile[i] = l ? 0.f : acc.getValue(c);
     }
+    // Rows along z: eight values from one leaf, the ninth from the next.
     for (int x = 0; x < N; ++x)
-        for (int y = 0; y < N; ++y)
-            for (int z = 0; z < N; ++z) {
-                const int i = (x >> 3) * 4 + (y >> 3) * 2 + (z >> 3);
-                const int offset = ((x & 7) << 6) | ((y & 7) << 3) | (z & 7);
-                dst[(x * N + y) * N + z] = leaf[i] ? leaf[i][offset] : tile[i];
-            }
+        for (int y = 0; y < N; ++y) {
+            const int i = (x >> 3) * 4 + (y >> 3) * 2, offset = ((x & 7) << 6) | ((y & 7) << 3);
+            float* row = dst + (x * N + y) * N;
+            if (leaf[i]) std::memcpy(row, leaf[i] + offset, 8 * sizeof(float));
+            else std::fill_n(row, 8, tile[i]);
+            row[8] = leaf[i + 1] ? leaf[i + 1][offset] : tile[i + 1];
+        }
 }
 
-uint32_t computeTightBox(const float* v) {
+// What the build keeps of a block besides its values.
+struct BlockSummary {
+    bool any = false, constant = false;
+    uint32_t tightBox = 0;
+    float minimum = 0, maximum = 0;
+};
+
+// One pass over the padded values. A cell touches the vertices c + {0,1}^3,
+// so the cells whose stencil holds a non-zero vertex v span, per axis,
+// [max(0, v - 1), min(7, v)]: the tight box follows from the smallest and
+// largest coordinates of the non-zero vertices.
+BlockSummary summarize(const float* v) {
     constexpr int N = PaddedBlocks::N;
-    int lo[3] = {8, 8, 8}, hi[3] = {0, 0, 0};
-    for (int x = 0; x < 8; ++x)
-        for (int y = 0; y < 8; ++y)
-            for (int z = 0; z < 8; ++z) {
-                bool nonZero = false;
-                for (int c = 0; c < 8 && !nonZero; ++c)
-                    nonZero = v[((x + (c >> 2)) * N + y + ((c >> 1) & 1)) * N + z + (c & 1)] != 0;
-                if (!nonZero) continue;
+    BlockSummary b;
+    int lo[3] = {N, N, N}, hi[3] = {-1, -1, -1};
+    float mn = v[0], mx = v[0];
+    bool constant = true;
+    for (int x = 0; x < N; ++x)
+        for (int y = 0; y < N; ++y) {
+            const float* row = v + (x * N + y) * N;
+            for (int z = 0; z < N; ++z) {
+                const float value = row[z];
+                mn = std::min(mn, value);
+                mx = std::max(mx, value);
+                constant = constant && value == v[0];
+                if (value == 0) continue;
                 const int p[3] = {x, y, z};
                 for (int a = 0; a < 3; ++a) {
                     lo[a] = std::min(lo[a], p[a]);
-                    hi[a] = std::max(hi[a], p[a] + 1);
+                    hi[a] = std::max(hi[a], p[a]);
                 }
             }
-    uint32_t packed = 0;
-    for (int a = 0; a < 3; ++a) packed |= uint32_t(lo[a]) << (4 * a) | uint32_t(hi[a]) << (12 + 4 * a);
-    return packed;
+        }
+    b.any = hi[0] >= 0;
+    b.constant = b.any && constant;
+    b.minimum = std::max(0.f, mn);
+    b.maximum = mx;
+    if (b.any)
+        for (int a = 0; a < 3; ++a)
+            b.tightBox |= uint32_t(std::max(0, lo[a] - 1)) << (4 * a) | uint32_t(std::min(8, hi[a] + 1)) << (12 + 4 * a);
+    return b;
 }
 
 // Gives freed heap pages back to the system (glibc keeps them otherwise, and
@@ -106,9 +182,11 @@ void PaddedBlocks::build(openvdb::FloatGrid& grid) {
     uint64_t freedSinceTrim = 0;
 
     std::vector<float> scratch;
-    std::vector<char> nonEmpty;
+    std::vector<char> nonEmpty, constant;
     std::vector<uint32_t> boxes;
     std::vector<float> maxima, minima;
+    std::vector<float*> places;
+    openvdb::tree::ValueAccessor<openvdb::Int32Tree> indexAccessor(index);
     for (size_t s = 0; s < origins.size();) {
         const int slabX = origins[s].x();
         size_t e = s;
@@ -116,6 +194,7 @@ void PaddedBlocks::build(openvdb::FloatGrid& grid) {
         const size_t n = e - s;
         scratch.resize(n * Size);
         nonEmpty.assign(n, 0);
+        constant.assign(n, 0);
         boxes.assign(n, 0);
         maxima.assign(n, 0.f);
         minima.assign(n, 0.f);
@@ -124,33 +203,33 @@ void PaddedBlocks::build(openvdb::FloatGrid& grid) {
             for (size_t b = r.begin(); b != r.end(); ++b) {
                 float* dst = &scratch[b * Size];
                 readPadded(acc, origins[s + b], dst);
-                const bool any = std::any_of(dst, dst + Size, [](float v) { return v != 0; });
-                nonEmpty[b] = any;
-                if (any) boxes[b] = computeTightBox(dst);
-                const auto range = std::minmax_element(dst, dst + Size);
-                minima[b] = std::max(0.f, *range.first);
-                maxima[b] = *range.second;
+                const BlockSummary sum = summarize(dst);
+                nonEmpty[b] = sum.any;
+                constant[b] = sum.constant;
+                boxes[b] = sum.tightBox;
+                minima[b] = sum.minimum;
+                maxima[b] = sum.maximum;
             }
         });
-        const size_t kept = size_t(std::count(nonEmpty.begin(), nonEmpty.end(), char(1)));
-        std::unique_ptr<float[]> slab(kept ? new float[kept * Size] : nullptr);
-        size_t k = 0;
+        // Each block's place (constant blocks share one copy), then the copies.
+        places.assign(n, nullptr);
+        for (size_t b = 0; b < n; ++b)
+            if (nonEmpty[b]) places[b] = constant[b] ? constantBlock(scratch[b * Size]) : allocateBlock();
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t b = r.begin(); b != r.end(); ++b)
+                if (nonEmpty[b] && !constant[b]) std::memcpy(places[b], &scratch[b * Size], Size * sizeof(float));
+        });
         for (size_t b = 0; b < n; ++b) {
             int32_t id = 0;
             if (nonEmpty[b]) {
-                float* dst = slab.get() + k * Size;
-                std::memcpy(dst, &scratch[b * Size], Size * sizeof(float));
-                blockValues.push_back(dst);
+                blockValues.push_back(places[b]);
                 tightBox.push_back(boxes[b]);
                 blockMax.push_back(maxima[b]);
                 blockMin.push_back(minima[b]);
                 id = int32_t(blockValues.size());
-                ++k;
             }
-            index.addTile(1, origins[s + b], id, true);
+            indexAccessor.addTile(1, origins[s + b], id, true);
         }
-        if (slab) mSlabs.push_back(std::move(slab));
-        mValueBytes += uint64_t(kept) * Size * sizeof(float);
         // Free the leaves no block still to build reads.
         for (; nextLeaf < leaves.size() && leaves[nextLeaf].x() <= slabX; ++nextLeaf) {
             if (LeafT* leaf = grid.tree().stealNode<LeafT>(leaves[nextLeaf], 0.f, false)) {
@@ -170,6 +249,74 @@ void PaddedBlocks::build(openvdb::FloatGrid& grid) {
     blockMax.shrink_to_fit();
     blockMin.shrink_to_fit();
     releaseFreedMemory();
+}
+
+PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activeVoxels,
+                                              const openvdb::CoordBBox& bounds) {
+    using Level2 = openvdb::FloatTree::RootNodeType::ChildNodeType;
+    using Level1 = Level2::ChildNodeType;
+    using BoolLeaf = openvdb::BoolTree::LeafNodeType;
+    // Interior nodes: one per node-sized cell the active box overlaps (an
+    // upper bound: a sparse grid leaves some out). Int32 and bool trees have
+    // the same 8-byte table entries as float trees.
+    auto cells = [&](int log2Size) {
+        uint64_t n = 1;
+        for (int a = 0; a < 3; ++a) n *= uint64_t((bounds.max()[a] >> log2Size) - (bounds.min()[a] >> log2Size) + 1);
+        return n;
+    };
+    const uint64_t level2Bytes = Level2::NUM_VALUES * sizeof(void*) + 2 * (Level2::NUM_VALUES / 8);
+    const uint64_t level1Bytes = Level1::NUM_VALUES * sizeof(void*) + 2 * (Level1::NUM_VALUES / 8);
+    const uint64_t interior = bounds.empty() ? 0
+                                             : cells(Level2::TOTAL) * level2Bytes + cells(Level1::TOTAL) * level1Bytes;
+    const uint64_t leafBytes = sizeof(LeafT) + LeafT::SIZE * sizeof(float);
+    const uint64_t leaves = std::max<uint64_t>((activeVoxels + LeafT::SIZE - 1) / LeafT::SIZE,
+                                               gridBytes > interior ? (gridBytes - interior) / leafBytes : 0);
+    // Blocks per leaf of the dilated topology, measured on the sample assets
+    // (docs/memory.md): 1.03-1.17 with values, 1.06-1.27 in all.
+    const uint64_t kept = leaves * 110 / 100, all = leaves * 125 / 100;
+    const uint64_t perBlock = Size * sizeof(float) + sizeof(float*) + sizeof(uint32_t) + 2 * sizeof(float);
+    const uint64_t lists = sizeof(openvdb::Coord) * (all + leaves);  // block origins, leaves in x order
+    const uint64_t slabs = bounds.empty() ? 1 : uint64_t(bounds.dim().x()) / 8 + 1;
+    const uint64_t scratch = 2 * all / slabs * Size * sizeof(float);  // the largest slab, taken as twice the mean
+    Footprint f;
+    f.resident = kept * perBlock + interior;
+    // At the start the grid and its dilated topology; at the end the blocks,
+    // the index and what is left of the grid (its interior nodes).
+    const uint64_t start = gridBytes + all * sizeof(BoolLeaf) + interior + lists;
+    const uint64_t end = f.resident + interior + lists + scratch;
+    f.loadPeak = std::max(start, end);
+    return f;
+}
+
+float* PaddedBlocks::allocateBlock() {
+    // Chunks of 32 MB, 2 MB aligned, with transparent huge pages asked for:
+    // the kernel then maps 2 MB per page fault, not 4 kB (in 4 kB pages the
+    // faults of a 1 GB build took 1.7 s).
+    constexpr size_t HugePage = size_t(2) << 20, ChunkBytes = size_t(32) << 20;
+    constexpr size_t BlocksPerChunk = ChunkBytes / (Size * sizeof(float));
+    if (mChunks.empty() || mChunkUsed == BlocksPerChunk) {
+        void* p = std::aligned_alloc(HugePage, ChunkBytes);
+        if (!p) throw std::bad_alloc();
+#if defined(MADV_HUGEPAGE)
+        ::madvise(p, ChunkBytes, MADV_HUGEPAGE);
+#endif
+        mChunks.emplace_back(static_cast<float*>(p));
+        mChunkUsed = 0;
+    }
+    mValueBytes += Size * sizeof(float);
+    return mChunks.back().get() + Size * mChunkUsed++;
+}
+
+float* PaddedBlocks::constantBlock(float value) {
+    uint32_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    std::unique_ptr<float[]>& block = mConstantBlocks[bits];
+    if (!block) {
+        block.reset(new float[Size]);
+        std::fill_n(block.get(), Size, value);
+        mValueBytes += Size * sizeof(float);
+    }
+    return block.get();
 }
 
 uint64_t PaddedBlocks::memoryBytes() const {

@@ -2,13 +2,16 @@
 // per 8x8x8 leaf-aligned block where trilinear samples can land. Every lookup
 // reads its eight corners from one contiguous block, with no tree traversal
 // while a ray stays inside it (a step of one voxel stays ~8 samples in a
-// block). The blocks answer every lookup, so the grid they are built from is
+// block). Blocks whose values are all equal share one copy. The blocks
+// answer every lookup, so the grid they are built from is
 // not kept: build() frees its leaves as it goes, and the peak memory of a load
 // is about the larger of the grid and the blocks, not their sum.
 // Includes OpenVDB; never include it outside volume/.
 #pragma once
 
 #include <cstdint>
+#include <cstdlib>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -43,15 +46,35 @@ struct PaddedBlocks {
     // thread count.
     void build(openvdb::FloatGrid& grid);
 
+    // Memory of a load, predicted from a float grid's metadata before reading:
+    // its in-memory size (OpenVDB's file_mem_bytes), active voxels and their
+    // bounding box. docs/memory.md has the formula and its measured accuracy.
+    struct Footprint {
+        uint64_t loadPeak = 0;  // above what the process held before the read
+        uint64_t resident = 0;  // the blocks and their index, once loaded
+    };
+    static Footprint predict(uint64_t gridBytes, uint64_t activeVoxels, const openvdb::CoordBBox& bounds);
+
     const float* block(int32_t id) const { return blockValues[size_t(id - 1)]; }
     size_t blockCount() const { return blockValues.size(); }
     // Memory held: block values, per-block tables and the index tree.
     uint64_t memoryBytes() const;
 
 private:
-    // Block values, one allocation per x slab of blocks (the order they are
-    // built in).
-    std::vector<std::unique_ptr<float[]>> mSlabs;
+    // The one block of `value` everywhere, shared by every block whose padded
+    // values all equal it (the inside of a constant region, an active tile).
+    float* constantBlock(float value);
+    // The next block's storage, in the current chunk.
+    float* allocateBlock();
+
+    struct FreeChunk {
+        void operator()(float* p) const { std::free(p); }
+    };
+    // Block values, carved in build order from large chunks, and the shared
+    // constant blocks by their value's bits.
+    std::vector<std::unique_ptr<float, FreeChunk>> mChunks;
+    size_t mChunkUsed = 0;
+    std::map<uint32_t, std::unique_ptr<float[]>> mConstantBlocks;
     uint64_t mValueBytes = 0;
 };
 

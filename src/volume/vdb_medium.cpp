@@ -13,10 +13,13 @@
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/tools/Morphology.h>
+#include <openvdb/tree/LeafManager.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "core/error.h"
+#include "core/fatal_guard.h"
 #include "core/memory.h"
 #include "core/transform.h"
 #include "volume/medium.h"
@@ -141,16 +144,36 @@ void toKelvin(openvdb::FloatGrid& grid, const MediumDesc& d, const std::string& 
 // NaN, Inf and negative values become 0 (counted, one warning); inactive
 // values and the background become 0 so that "inactive" means "empty".
 void sanitize(openvdb::FloatGrid& grid, const std::string& what) {
-    size_t bad = 0;
-    for (auto it = grid.tree().beginValueAll(); it; ++it) {
-        float v = *it;
-        if (!it.isValueOn()) {
-            if (v != 0) it.setValue(0.f);
-            continue;
-        }
-        if (!std::isfinite(v) || v < 0) {
+    // Leaves in parallel, then the tiles of the interior nodes (a tile counts
+    // once, as one value).
+    openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
+    size_t bad = tbb::parallel_reduce(
+        leaves.leafRange(), size_t(0),
+        [](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& r, size_t count) {
+            for (auto leaf = r.begin(); leaf; ++leaf) {
+                float* v = leaf->buffer().data();
+                const auto& on = leaf->getValueMask();
+                for (openvdb::Index i = 0; i < LeafT::SIZE; ++i) {
+                    if (!on.isOn(i)) {
+                        if (v[i] != 0) v[i] = 0;
+                    } else if (!std::isfinite(v[i]) || v[i] < 0) {
+                        ++count;
+                        v[i] = 0;
+                    }
+                }
+            }
+            return count;
+        },
+        std::plus<size_t>());
+    auto tiles = grid.tree().beginValueAll();
+    tiles.setMaxDepth(openvdb::FloatTree::DEPTH - 2);
+    for (; tiles; ++tiles) {
+        const float v = *tiles;
+        if (!tiles.isValueOn()) {
+            if (v != 0) tiles.setValue(0.f);
+        } else if (!std::isfinite(v) || v < 0) {
             ++bad;
-            it.setValue(0.f);
+            tiles.setValue(0.f);
         }
     }
     float bg = grid.background();
@@ -271,6 +294,11 @@ public:
         // Guards the read and everything that walks or frees what it built:
         // heap damage from a bad file shows there, when glibc checks a free.
         const auto guard = guardVdbRead(d.file);
+        const MediumMemory need = predictMediumMemory(d);
+        if (need.loading > 0)
+            checkMemory(residentMemoryBytes() + need.loading,
+                        str(what, " (", formatBytes(need.gridBytes), " in memory; loading it with what this process "
+                                  "holds, docs/memory.md)"));
         mDensity = readFloatGrid(d.file, d.grid);
         sanitize(*mDensity, what);
         mScale = d.densityScale;
@@ -284,26 +312,21 @@ public:
             mMinVoxel = std::min(mMinVoxel, float(len));
         }
         mActiveVoxels = mDensity->activeVoxelCount();
-        float lo = 0, hi = 0;
-        bool any = false;
-        for (auto it = mDensity->cbeginValueOn(); it; ++it) {
-            if (!any) lo = hi = *it;
-            lo = std::min(lo, *it);
-            hi = std::max(hi, *it);
-            any = true;
-        }
-        mMaxDensity = hi * mScale;
-        if (mActiveVoxels == 0 || mMaxDensity <= 0) {
-            warn(str(what, " has no active voxels with density > 0: the medium is empty"));
-            mMaxDensity = 0;
-        }
         // The padded blocks answer every density lookup: the grid's leaves
-        // are freed while they are built, and the grid is dropped.
-        if (mMaxDensity > 0) {
+        // are freed while they are built, and the grid is dropped. Their
+        // largest value is the grid's (inactive values are 0).
+        if (mActiveVoxels > 0) {
             mBlocks.build(*mDensity);
             const openvdb::CoordBBox& ib = mBlocks.activeBounds;
             mIndexLo = openvdb::Vec3d(ib.min().x(), ib.min().y(), ib.min().z());
             mIndexHi = openvdb::Vec3d(ib.max().x() + 1, ib.max().y() + 1, ib.max().z() + 1);
+        }
+        float hi = 0;
+        for (float m : mBlocks.blockMax) hi = std::max(hi, m);
+        mMaxDensity = hi * mScale;
+        if (mActiveVoxels == 0 || mMaxDensity <= 0) {
+            warn(str(what, " has no active voxels with density > 0: the medium is empty"));
+            mMaxDensity = 0;
         }
         mDensity.reset();
         if (mMaxDensity > 0)
@@ -588,14 +611,14 @@ void VdbQuery::forEachMajorant(const Ray& r, float tMin, float tMax,
 
 }  // namespace
 
-// Picks the grid by name; with an empty name prefers "density", else the first
-// scalar grid. Reads it and returns it as a float grid.
-openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string& wanted, std::string* chosenName) {
-    const auto guard = guardVdbRead(path);
-    auto file = openVdbFile(path);
+namespace {
+
+// The grid `wanted` names; with an empty name "density", else the first
+// scalar grid. Throws InputError listing the grids when there is none.
+std::string chooseGrid(openvdb::io::File& file, const std::string& path, const std::string& wanted) {
     std::string name = wanted;
     if (name.empty()) {
-        auto grids = file->readAllGridMetadata();
+        auto grids = file.readAllGridMetadata();
         for (const auto& g : *grids)
             if (g->getName() == "density") name = "density";
         if (name.empty())
@@ -604,21 +627,84 @@ openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string
                     name = g->getName();
                     break;
                 }
-        if (name.empty()) throw InputError(str(path, ": no float grid in the file; grids: ", gridListing(*file)));
+        if (name.empty()) throw InputError(str(path, ": no float grid in the file; grids: ", gridListing(file)));
     }
-    if (!file->hasGrid(name))
-        throw InputError(str(path, ": no grid named '", name, "'; grids in the file: ", gridListing(*file)));
-    // The grid, its dilated topology and the padded blocks the walk reads:
-    // about three times the grid's own size, refused before reading it.
+    if (!file.hasGrid(name))
+        throw InputError(str(path, ": no grid named '", name, "'; grids in the file: ", gridListing(file)));
+    return name;
+}
+
+// What OpenVDB's writer records of a grid: its in-memory size, active voxels
+// and their bounds (known = false for files written without them).
+struct GridStats {
+    bool known = false, isDouble = false;
+    uint64_t bytes = 0, voxels = 0;
+    openvdb::CoordBBox bounds;
+};
+
+GridStats gridStats(openvdb::io::File& file, const std::string& name) {
+    GridStats s;
     try {
-        const auto meta = file->readGridMetadata(name);
-        if (const auto bytes = meta->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_MEM_BYTES))
-            checkMemory(3 * uint64_t(std::max<int64_t>(0, bytes->value())),
-                        str(path, ": grid '", name, "' (", formatBytes(uint64_t(bytes->value())), " in memory)"));
-    } catch (const InputError&) {
-        throw;
-    } catch (const std::exception&) {  // no metadata: nothing to check before reading
+        const auto meta = file.readGridMetadata(name);
+        const auto bytes = meta->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_MEM_BYTES);
+        const auto voxels = meta->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
+        const auto lo = meta->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+        const auto hi = meta->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+        if (!bytes) return s;
+        s.known = true;
+        s.isDouble = meta->isType<openvdb::DoubleGrid>();
+        s.bytes = uint64_t(std::max<int64_t>(0, bytes->value()));
+        s.voxels = voxels ? uint64_t(std::max<int64_t>(0, voxels->value())) : 0;
+        if (lo && hi) s.bounds = openvdb::CoordBBox(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
+    } catch (const std::exception&) {  // no metadata: nothing known before reading
     }
+    return s;
+}
+
+// The grid's load: PaddedBlocks::predict on its float size (a double grid is
+// held while its float copy is made).
+PaddedBlocks::Footprint gridFootprint(const GridStats& g) {
+    const uint64_t floatBytes = g.isDouble ? g.bytes / 2 : g.bytes;
+    PaddedBlocks::Footprint f = PaddedBlocks::predict(floatBytes, g.voxels, g.bounds);
+    if (g.isDouble) f.loadPeak += g.bytes;
+    return f;
+}
+
+}  // namespace
+
+MediumMemory predictMediumMemory(const MediumDesc& d) {
+    MediumMemory m;
+    if (d.type != MediumDesc::Type::Vdb) return m;
+    auto file = openVdbFile(d.file);
+    const GridStats density = gridStats(*file, chooseGrid(*file, d.file, d.grid));
+    if (!density.known) return m;
+    const PaddedBlocks::Footprint f = gridFootprint(density);
+    m.gridBytes = density.bytes;
+    m.loading = f.loadPeak;
+    m.resident = f.resident;
+    if (d.hasEmission) {
+        // The emission grid is kept as read; the emission sampler adds a
+        // coordinate, a cdf entry and a weight (24 bytes) per voxel of its
+        // topology dilated by one (about 1.3 per active voxel).
+        const GridStats e = gridStats(*file, chooseGrid(*file, d.file, d.emissionGrid));
+        const uint64_t sampler = e.voxels * 13 / 10 * 24;
+        m.loading = std::max(m.loading, m.resident + e.bytes + (e.isDouble ? e.bytes : 0));
+        m.resident += (e.isDouble ? e.bytes / 2 : e.bytes) + sampler;
+    }
+    return m;
+}
+
+// Reads the grid `wanted` names (chooseGrid) as a float grid.
+openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const std::string& wanted, std::string* chosenName) {
+    const auto guard = guardVdbRead(path);
+    auto file = openVdbFile(path);
+    const std::string name = chooseGrid(*file, path, wanted);
+    // The read itself, refused before it starts when it cannot fit beside
+    // what the process holds (a medium checks its whole load first).
+    const GridStats stats = gridStats(*file, name);
+    if (stats.known)
+        checkMemory(residentMemoryBytes() + stats.bytes + (stats.isDouble ? stats.bytes / 2 : 0),
+                    str(path, ": grid '", name, "' (", formatBytes(stats.bytes), " in memory)"));
     openvdb::GridBase::Ptr base;
     try {
         base = file->readGrid(name);
