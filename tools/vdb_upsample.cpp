@@ -58,6 +58,13 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+std::string num(double v)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
 struct Options {
     std::string in, out, grid = "density", compression = "blosc";
     int factor = 0;
@@ -451,6 +458,10 @@ int main(int argc, char** argv)
                     static_cast<unsigned long long>(st.leafCount()),
                     static_cast<unsigned long long>(st.activeTileCount()), src->voxelSize().x());
 
+        if (!(src->background() <= o.threshold))
+            throw std::runtime_error("grid '" + o.grid + "' in " + o.in + ": its background " +
+                                     num(src->background()) + " is above --threshold " + num(o.threshold) +
+                                     " (all of space would be active)");
         const int n = o.factor;
         const std::vector<Coord> origins = outputLeafOrigins(st, n);
         std::printf("x%d: %zu candidate output leaves (%.1f s)\n", n, origins.size(), since(t0));
@@ -470,7 +481,7 @@ int main(int argc, char** argv)
         const double written = since(t1);
 
         std::printf("%s: grid '%s' x%d%s\n", o.out.c_str(), o.grid.c_str(), n,
-                    o.detail != 0.0 ? (", detail " + std::to_string(o.detail) + " seed " +
+                    o.detail != 0.0 ? (", detail " + num(o.detail) + " seed " +
                                        std::to_string(o.seed)).c_str() : "");
         std::printf("  active voxels  %llu\n", static_cast<unsigned long long>(grid->activeVoxelCount()));
         std::printf("  leaves         %llu (active tiles %llu)\n",

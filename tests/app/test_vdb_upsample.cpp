@@ -190,6 +190,7 @@ TEST_F(VdbUpsample, BadInputIsRefusedByName) {
         {{source(), "out.vdb", "--factor", "2", "--grid", "smoke"}, 1, {source(), "'smoke'", "density"}},
         {{"grids.vdb", "out.vdb", "--factor", "2", "--grid", "vel"}, 1, {"grids.vdb", "'vel'", "vec3s", "float"}},
         {{"not_a_vdb.vdb", "out.vdb", "--factor", "2"}, 1, {"not_a_vdb.vdb"}},
+        {{source(), "out.vdb", "--factor", "2", "--threshold", "-1"}, 1, {source(), "'density'", "--threshold"}},
         {{source(), "out.vdb", "--factor", "33"}, 2, {"--factor", "1 to 32", "'33'"}},
         {{source(), "out.vdb", "--factor", "0"}, 2, {"--factor", "'0'"}},
         {{source(), "out.vdb"}, 2, {"--factor"}},
