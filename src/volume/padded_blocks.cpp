@@ -237,7 +237,7 @@ void PaddedBlocks::build(openvdb::FloatGrid& grid) {
                 delete leaf;
             }
         }
-        if (freedSinceTrim > (uint64_t(64) << 20)) {
+        if (freedSinceTrim > (uint64_t(16) << 20)) {
             releaseFreedMemory();
             freedSinceTrim = 0;
         }
@@ -255,10 +255,9 @@ PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activ
                                               const openvdb::CoordBBox& bounds) {
     using Level2 = openvdb::FloatTree::RootNodeType::ChildNodeType;
     using Level1 = Level2::ChildNodeType;
-    using BoolLeaf = openvdb::BoolTree::LeafNodeType;
     // Interior nodes: one per node-sized cell the active box overlaps (an
-    // upper bound: a sparse grid leaves some out). Int32 and bool trees have
-    // the same 8-byte table entries as float trees.
+    // upper bound: a sparse grid leaves some out). The Int32 index has
+    // the same 8-byte table entries as the float grid.
     auto cells = [&](int log2Size) {
         uint64_t n = 1;
         for (int a = 0; a < 3; ++a) n *= uint64_t((bounds.max()[a] >> log2Size) - (bounds.min()[a] >> log2Size) + 1);
@@ -269,10 +268,13 @@ PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activ
     const uint64_t interior = bounds.empty() ? 0
                                              : cells(Level2::TOTAL) * level2Bytes + cells(Level1::TOTAL) * level1Bytes;
     const uint64_t leafBytes = sizeof(LeafT) + LeafT::SIZE * sizeof(float);
-    const uint64_t leaves = std::max<uint64_t>((activeVoxels + LeafT::SIZE - 1) / LeafT::SIZE,
-                                               gridBytes > interior ? (gridBytes - interior) / leafBytes : 0);
-    // Blocks per leaf of the dilated topology, measured on the sample assets
-    // (docs/memory.md): 1.03-1.17 with values, 1.06-1.27 in all.
+    // Leaves from the grid's size; its active voxels only where the size
+    // says nothing (active tiles hold voxels without leaves, and become
+    // shared constant blocks).
+    uint64_t leaves = gridBytes > interior ? (gridBytes - interior) / leafBytes : 0;
+    if (leaves == 0) leaves = (activeVoxels + LeafT::SIZE - 1) / LeafT::SIZE;
+    // Blocks with their own values per leaf, measured on the sample assets
+    // and the upsampled clouds (docs/memory.md): 1.03-1.17; in all 1.06-1.27.
     const uint64_t kept = leaves * 110 / 100, all = leaves * 125 / 100;
     const uint64_t perBlock = Size * sizeof(float) + sizeof(float*) + sizeof(uint32_t) + 2 * sizeof(float);
     const uint64_t lists = sizeof(openvdb::Coord) * (all + leaves);  // block origins, leaves in x order
@@ -280,9 +282,9 @@ PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activ
     const uint64_t scratch = 2 * all / slabs * Size * sizeof(float);  // the largest slab, taken as twice the mean
     Footprint f;
     f.resident = kept * perBlock + interior;
-    // At the start the grid and its dilated topology; at the end the blocks,
-    // the index and what is left of the grid (its interior nodes).
-    const uint64_t start = gridBytes + all * sizeof(BoolLeaf) + interior + lists;
+    // At the start the grid; at the end the blocks, their index and what is
+    // left of the grid (its interior nodes).
+    const uint64_t start = gridBytes + lists;
     const uint64_t end = f.resident + interior + lists + scratch;
     f.loadPeak = std::max(start, end);
     return f;
