@@ -47,8 +47,11 @@ TEST(Blackbody, Rec709MatrixMapsD65ToEqualRgbAndPrimariesToChannels) {
     const double px[3] = {0.64, 0.30, 0.15}, py[3] = {0.33, 0.60, 0.06};
     for (int p = 0; p < 3; ++p) {
         const Color rgb = xyzToRec709(fromXy(px[p], py[p]));
-        for (int c = 0; c < 3; ++c)
-            if (c != p) EXPECT_NEAR(rgb[c] / rgb[p], 0.0, 1e-6) << "primary " << p << " channel " << c;
+        for (int c = 0; c < 3; ++c) {
+            if (c != p) {
+                EXPECT_NEAR(rgb[c] / rgb[p], 0.0, 1e-6) << "primary " << p << " channel " << c;
+            }
+        }
         // A primary of Y = 1 has 1 / (its luminance weight) in its channel:
         // 0.2126, 0.7152, 0.0722 (BT.709, rounded to 4 decimals).
         EXPECT_NEAR(1 / rgb[p], luminance(Color(p == 0, p == 1, p == 2)), 5e-5) << p;
