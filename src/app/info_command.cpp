@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "app/vdb_check.h"
+#include "core/memory.h"
 #include "volume/medium.h"
 
 namespace vdbmarch {
@@ -15,6 +16,16 @@ int runInfo(const InfoArgs& a) {
                 s.gridName.c_str(), s.activeVoxels, double(s.voxelSize), double(s.minValue), double(s.maxValue),
                 double(s.meanValue), double(s.worldBounds.lo.x), double(s.worldBounds.lo.y), double(s.worldBounds.lo.z),
                 double(s.worldBounds.hi.x), double(s.worldBounds.hi.y), double(s.worldBounds.hi.z));
+    // What rendering it as a medium takes (docs/memory.md).
+    MediumDesc medium;
+    medium.type = MediumDesc::Type::Vdb;
+    medium.file = a.file;
+    medium.grid = s.gridName;
+    const MediumMemory need = predictMediumMemory(medium);
+    if (need.gridBytes > 0)
+        std::printf("memory: grid %s; as a medium about %s while loading, %s once loaded (predicted)\n",
+                    formatBytes(need.gridBytes).c_str(), formatBytes(need.loading).c_str(),
+                    formatBytes(need.resident).c_str());
     return 0;
 }
 

@@ -4,6 +4,7 @@
 // MediumQuery made once per tile.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -80,6 +81,9 @@ public:
     virtual float minVoxelSize() const { return 0; }
     virtual float maxDensity() const = 0;
     virtual size_t activeVoxelCount() const { return 0; }
+    // Bytes held for lookups and walks (the blocks, their index, an emission
+    // grid); what predictMediumMemory's `resident` predicts.
+    virtual uint64_t memoryBytes() const { return 0; }
     // World boxes that together cover every point with density > 0: one per
     // non-empty 8^3 VDB block, the box of a bounded homogeneous medium, none
     // for unbounded fog (which has an infinite worldBounds()).

@@ -355,6 +355,9 @@ public:
     float minVoxelSize() const override { return mMinVoxel; }
     float maxDensity() const override { return mMaxDensity; }
     size_t activeVoxelCount() const override { return mActiveVoxels; }
+    uint64_t memoryBytes() const override {
+        return mBlocks.memoryBytes() + (mEmissionGrid ? uint64_t(mEmissionGrid->memUsage()) : 0);
+    }
     void activeBoxes(std::vector<BBox>& out) const override;
     std::unique_ptr<EmissionSampler> makeEmissionSampler() const override;
 
