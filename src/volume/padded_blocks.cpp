@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <new>
 
 #include <sys/mman.h>
@@ -19,7 +20,10 @@ namespace vdbmarch {
 namespace {
 
 using LeafT = openvdb::FloatTree::LeafNodeType;
+using Level1 = openvdb::FloatTree::RootNodeType::ChildNodeType::ChildNodeType;
 using openvdb::Coord;
+// Blocks read into the scratch at a time (12 MB).
+constexpr size_t PieceBlocks = 4096;
 
 // For each of the 26 neighbouring leaves, the voxels of a leaf whose
 // 26-neighbourhood reaches into it (x = 7 towards +x, x = 0 towards -x,
@@ -53,7 +57,7 @@ std::vector<NeighbourReach> neighbourReaches() {
 // leaf, the neighbours its active voxels reach, and the blocks of active
 // tiles (tiles are not dilated); done on the leaves' masks, in a tree with one
 // voxel per block, without building the dilated tree.
-std::vector<Coord> dilatedBlockOrigins(const openvdb::FloatTree& tree, openvdb::CoordBBox& bounds) {
+std::deque<Coord> dilatedBlockOrigins(const openvdb::FloatTree& tree, openvdb::CoordBBox& bounds) {
     static const std::vector<NeighbourReach> reaches = neighbourReaches();
     openvdb::BoolTree blocks(false);
     openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(blocks);
@@ -83,8 +87,7 @@ std::vector<Coord> dilatedBlockOrigins(const openvdb::FloatTree& tree, openvdb::
             for (int y = box.min().y(); y <= box.max().y(); y += 8)
                 for (int z = box.min().z(); z <= box.max().z(); z += 8) acc.setValueOn(Coord(x, y, z) >> 3);
     }
-    std::vector<Coord> origins;
-    origins.reserve(size_t(blocks.activeVoxelCount()));
+    std::deque<Coord> origins;
     for (auto it = blocks.cbeginValueOn(); it; ++it) {
         const Coord b = it.getCoord();
         origins.emplace_back(b.x() * 8, b.y() * 8, b.z() * 8);
@@ -170,84 +173,99 @@ void releaseFreedMemory() {
 
 }  // namespace
 
+void PaddedBlocks::buildPiece(const openvdb::FloatGrid& grid, const Coord* origins, size_t n,
+                              std::vector<float>& scratch,
+                              openvdb::tree::ValueAccessor<openvdb::Int32Tree>& indexAccessor) {
+    scratch.resize(n * Size);
+    std::vector<BlockSummary> summaries(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16), [&](const tbb::blocked_range<size_t>& r) {
+        auto acc = grid.getConstAccessor();
+        for (size_t b = r.begin(); b != r.end(); ++b) {
+            float* dst = &scratch[b * Size];
+            readPadded(acc, origins[b], dst);
+            summaries[b] = summarize(dst);
+        }
+    });
+    // Each block's place (constant blocks share one copy), then the copies.
+    std::vector<float*> places(n, nullptr);
+    for (size_t b = 0; b < n; ++b)
+        if (summaries[b].any) places[b] = summaries[b].constant ? constantBlock(scratch[b * Size]) : allocateBlock();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t b = r.begin(); b != r.end(); ++b)
+            if (summaries[b].any && !summaries[b].constant)
+                std::memcpy(places[b], &scratch[b * Size], Size * sizeof(float));
+    });
+    for (size_t b = 0; b < n; ++b) {
+        int32_t id = 0;
+        if (summaries[b].any) {
+            blockValues.push_back(places[b]);
+            tightBox.push_back(summaries[b].tightBox);
+            blockMax.push_back(summaries[b].maximum);
+            blockMin.push_back(summaries[b].minimum);
+            id = int32_t(blockValues.size());
+        }
+        indexAccessor.addTile(1, origins[b], id, true);
+    }
+}
+
 void PaddedBlocks::build(openvdb::FloatGrid& grid) {
-    std::vector<Coord> origins = dilatedBlockOrigins(grid.tree(), activeBounds);
+    // Consumed from the front as the build goes: a deque gives its memory
+    // back chunk by chunk (at the end of a large build, the peak).
+    std::deque<Coord> origins = dilatedBlockOrigins(grid.tree(), activeBounds);
     // The grid's leaves in x order: a block at x reads x .. x + 8, so once the
     // blocks of slab X are built, no later block reads a leaf at x <= X.
-    std::vector<Coord> leaves;
-    leaves.reserve(grid.tree().leafCount());
+    std::deque<Coord> leaves;
     for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf->origin());
     std::sort(leaves.begin(), leaves.end());
-    size_t nextLeaf = 0;
     uint64_t freedSinceTrim = 0;
+    // The interior nodes just above the leaves, in x order.
+    std::vector<Coord> nodes;
+    for (auto top = grid.tree().root().cbeginChildOn(); top; ++top)
+        for (auto node = top->cbeginChildOn(); node; ++node) nodes.push_back(node->origin());
+    std::sort(nodes.begin(), nodes.end());
+    size_t nextNode = 0;
 
     std::vector<float> scratch;
-    std::vector<char> nonEmpty, constant;
-    std::vector<uint32_t> boxes;
-    std::vector<float> maxima, minima;
-    std::vector<float*> places;
+    std::vector<Coord> piece;
     openvdb::tree::ValueAccessor<openvdb::Int32Tree> indexAccessor(index);
-    for (size_t s = 0; s < origins.size();) {
-        const int slabX = origins[s].x();
-        size_t e = s;
-        while (e < origins.size() && origins[e].x() == slabX) ++e;
-        const size_t n = e - s;
-        scratch.resize(n * Size);
-        nonEmpty.assign(n, 0);
-        constant.assign(n, 0);
-        boxes.assign(n, 0);
-        maxima.assign(n, 0.f);
-        minima.assign(n, 0.f);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16), [&](const tbb::blocked_range<size_t>& r) {
-            auto acc = grid.getConstAccessor();
-            for (size_t b = r.begin(); b != r.end(); ++b) {
-                float* dst = &scratch[b * Size];
-                readPadded(acc, origins[s + b], dst);
-                const BlockSummary sum = summarize(dst);
-                nonEmpty[b] = sum.any;
-                constant[b] = sum.constant;
-                boxes[b] = sum.tightBox;
-                minima[b] = sum.minimum;
-                maxima[b] = sum.maximum;
+    // The tables hold at most one entry per block: reserved once, so no
+    // growth copies them at the end of a large build (the peak).
+    const size_t blockCount = origins.size();
+    blockValues.reserve(blockCount);
+    tightBox.reserve(blockCount);
+    blockMax.reserve(blockCount);
+    blockMin.reserve(blockCount);
+    while (!origins.empty()) {
+        const int slabX = origins.front().x();
+        // Pieces of a slab at a time: the scratch stays small.
+        while (!origins.empty() && origins.front().x() == slabX) {
+            piece.clear();
+            while (!origins.empty() && origins.front().x() == slabX && piece.size() < PieceBlocks) {
+                piece.push_back(origins.front());
+                origins.pop_front();
             }
-        });
-        // Each block's place (constant blocks share one copy), then the copies.
-        places.assign(n, nullptr);
-        for (size_t b = 0; b < n; ++b)
-            if (nonEmpty[b]) places[b] = constant[b] ? constantBlock(scratch[b * Size]) : allocateBlock();
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t b = r.begin(); b != r.end(); ++b)
-                if (nonEmpty[b] && !constant[b]) std::memcpy(places[b], &scratch[b * Size], Size * sizeof(float));
-        });
-        for (size_t b = 0; b < n; ++b) {
-            int32_t id = 0;
-            if (nonEmpty[b]) {
-                blockValues.push_back(places[b]);
-                tightBox.push_back(boxes[b]);
-                blockMax.push_back(maxima[b]);
-                blockMin.push_back(minima[b]);
-                id = int32_t(blockValues.size());
-            }
-            indexAccessor.addTile(1, origins[s + b], id, true);
+            buildPiece(grid, piece.data(), piece.size(), scratch, indexAccessor);
         }
-        // Free the leaves no block still to build reads.
-        for (; nextLeaf < leaves.size() && leaves[nextLeaf].x() <= slabX; ++nextLeaf) {
-            if (LeafT* leaf = grid.tree().stealNode<LeafT>(leaves[nextLeaf], 0.f, false)) {
+        // Free the leaves, then the interior nodes, that no block still to
+        // build reads (a 16^3-leaf node once its last column is done).
+        for (; !leaves.empty() && leaves.front().x() <= slabX; leaves.pop_front()) {
+            if (LeafT* leaf = grid.tree().stealNode<LeafT>(leaves.front(), 0.f, false)) {
                 freedSinceTrim += leaf->memUsage();
                 delete leaf;
+            }
+        }
+        for (; nextNode < nodes.size() && nodes[nextNode].x() + int(Level1::DIM) - 8 <= slabX; ++nextNode) {
+            if (Level1* node = grid.tree().stealNode<Level1>(nodes[nextNode], 0.f, false)) {
+                freedSinceTrim += node->memUsage();
+                delete node;
             }
         }
         if (freedSinceTrim > (uint64_t(16) << 20)) {
             releaseFreedMemory();
             freedSinceTrim = 0;
         }
-        s = e;
     }
     scratch = std::vector<float>();
-    blockValues.shrink_to_fit();
-    tightBox.shrink_to_fit();
-    blockMax.shrink_to_fit();
-    blockMin.shrink_to_fit();
     releaseFreedMemory();
 }
 

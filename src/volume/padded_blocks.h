@@ -61,6 +61,10 @@ struct PaddedBlocks {
     uint64_t memoryBytes() const;
 
 private:
+    // Reads n blocks of the grid at `origins` into `scratch`, keeps their
+    // values and tables and adds them to the index.
+    void buildPiece(const openvdb::FloatGrid& grid, const openvdb::Coord* origins, size_t n,
+                    std::vector<float>& scratch, openvdb::tree::ValueAccessor<openvdb::Int32Tree>& indexAccessor);
     // The one block of `value` everywhere, shared by every block whose padded
     // values all equal it (the inside of a constant region, an active tile).
     float* constantBlock(float value);
