@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
     CLI::App* check = app.add_subcommand(
         "check", "Read every grid of VDB files fully, in a separate process: exit 1 naming each damaged or cut file");
     check->add_option("files", cka.files, "VDB files")->required();
-    check->add_flag("--in-process", cka.inProcess, "Read in this process (no isolation: a damaged file may crash it)");
+    check->add_flag("--in-process", cka.inProcess, "Read in this process, guarded: a damaged file ends the command with a message naming it (without this flag each file is read in its own process, so one damaged file does not stop the check of the others)");
     check->add_flag("-q,--quiet", cka.quiet, "Print nothing for files that read cleanly");
 
     InfoArgs fa;
