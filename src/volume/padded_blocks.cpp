@@ -272,7 +272,6 @@ void PaddedBlocks::build(openvdb::FloatGrid& grid) {
 PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activeVoxels,
                                               const openvdb::CoordBBox& bounds) {
     using Level2 = openvdb::FloatTree::RootNodeType::ChildNodeType;
-    using Level1 = Level2::ChildNodeType;
     // Interior nodes: one per node-sized cell the active box overlaps (an
     // upper bound: a sparse grid leaves some out). The Int32 index has
     // the same 8-byte table entries as the float grid.

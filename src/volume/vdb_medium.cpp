@@ -143,6 +143,18 @@ void toKelvin(openvdb::FloatGrid& grid, const MediumDesc& d, const std::string& 
 
 // NaN, Inf and negative values become 0 (counted, one warning); inactive
 // values and the background become 0 so that "inactive" means "empty".
+// One value's rule: inactive becomes 0; active NaN, Inf or negative becomes
+// 0 and counts (returns true).
+inline bool sanitizeValue(float& v, bool active) {
+    if (!active) {
+        if (v != 0) v = 0;
+        return false;
+    }
+    if (std::isfinite(v) && v >= 0) return false;
+    v = 0;
+    return true;
+}
+
 void sanitize(openvdb::FloatGrid& grid, const std::string& what) {
     // Leaves in parallel, then the tiles of the interior nodes (a tile counts
     // once, as one value).
@@ -153,14 +165,7 @@ void sanitize(openvdb::FloatGrid& grid, const std::string& what) {
             for (auto leaf = r.begin(); leaf; ++leaf) {
                 float* v = leaf->buffer().data();
                 const auto& on = leaf->getValueMask();
-                for (openvdb::Index i = 0; i < LeafT::SIZE; ++i) {
-                    if (!on.isOn(i)) {
-                        if (v[i] != 0) v[i] = 0;
-                    } else if (!std::isfinite(v[i]) || v[i] < 0) {
-                        ++count;
-                        v[i] = 0;
-                    }
-                }
+                for (openvdb::Index i = 0; i < LeafT::SIZE; ++i) count += sanitizeValue(v[i], on.isOn(i));
             }
             return count;
         },
@@ -168,13 +173,10 @@ void sanitize(openvdb::FloatGrid& grid, const std::string& what) {
     auto tiles = grid.tree().beginValueAll();
     tiles.setMaxDepth(openvdb::FloatTree::DEPTH - 2);
     for (; tiles; ++tiles) {
-        const float v = *tiles;
-        if (!tiles.isValueOn()) {
-            if (v != 0) tiles.setValue(0.f);
-        } else if (!std::isfinite(v) || v < 0) {
-            ++bad;
-            tiles.setValue(0.f);
-        }
+        float v = *tiles;
+        const float before = v;
+        bad += sanitizeValue(v, tiles.isValueOn());
+        if (v != before) tiles.setValue(v);  // NaN != 0 too
     }
     float bg = grid.background();
     if (bg != 0) {
