@@ -153,10 +153,10 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         // The last event max_depth allows: a path from here could only find
         // lights and the background straight along its first direction,
         // which next-event estimation samples directly (no path needed).
-        static constexpr DirectLightOptions kLastEvent{TransmittanceEstimator::RatioTracking, false, true};
+        static constexpr DirectLightOptions kLastEvent{TransmittanceEstimator::UnbiasedMarching, false, true};
         return direct(directLight(ctx, region, vertex, rng, kLastEvent)) + photons();
     }
-    static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::RatioTracking, true, false};
+    static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::UnbiasedMarching, true, false};
     // The continuation's direction: phase x cached radiance where the cache
     // has a cell, else the phase. Next-event estimation weighs its sphere-
     // light samples against that same density (MIS).

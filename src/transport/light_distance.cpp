@@ -147,10 +147,11 @@ Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, 
         if (!mp.scatters()) continue;
         float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
         if (!(w > 0) || !russianRoulette(w, rng, MisWeightRouletteThreshold)) continue;
-        const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng);
+        // Light that ends here: the quiet unbiased estimator (transmittance.h).
+        const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng, TransmittanceEstimator::UnbiasedMarching);
         if (isBlack(T)) continue;
         DirectLightOptions o;
-        o.transmittance = TransmittanceEstimator::RatioTracking;
+        o.transmittance = TransmittanceEstimator::UnbiasedMarching;
         o.misWithPathHits = true;  // a sphere light is also found by the phase-sampled path
         o.sampleBackground = false;
         o.onlyLight = ld.light;

@@ -17,7 +17,7 @@ namespace {
 // hit by the path, a constant background only by the path, an environment
 // map by both.
 DirectLightOptions nextEventOptions(const PathState& st, const float* lightWeights = nullptr) {
-    return {TransmittanceEstimator::RatioTracking, true, false, st.pointLightsByPhotons, lightWeights};
+    return {TransmittanceEstimator::UnbiasedMarching, true, false, st.pointLightsByPhotons, lightWeights};
 }
 
 // Russian roulette on the throughput after RouletteMinDepth events.

@@ -40,8 +40,15 @@ enum class TransmittanceEstimator {
     // exp(-tau) with tau integrated in uniform steps of render.shadow_step
     // from a random offset (the marchers: cheap, consistent as steps shrink).
     Stepped,
-    // Residual ratio tracking against local density bounds (the reference: unbiased).
+    // Residual ratio tracking against local density bounds: unbiased, each
+    // estimate in [0, 1] (what a path's throughput may be multiplied by).
     RatioTracking,
+    // Unbiased ray marching (Kettunen et al. 2021): the power series of
+    // core/power_series.h over stratified optical-depth estimates. Unbiased
+    // and nearly as quiet as Stepped; one estimate may be negative or above
+    // 1, so it weighs light that ends there (next-event estimation), not a
+    // path that goes on.
+    UnbiasedMarching,
 };
 
 // Transmittance from p along the unit direction wi over `dist` (Infinity
@@ -51,7 +58,8 @@ Color shadowTransmittance(ThreadContext& ctx, int region, const Vec3& p, const V
                           TransmittanceEstimator estimator);
 
 // Transmittance along [0, tEnd) of ray r inside `region` (no surface in
-// between), by ratio tracking: unbiased; constant media exactly.
-Color regionTransmittance(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng);
+// between); constant media exactly.
+Color regionTransmittance(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rng& rng,
+                          TransmittanceEstimator estimator = TransmittanceEstimator::RatioTracking);
 
 }  // namespace vdbmarch

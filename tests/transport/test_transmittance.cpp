@@ -1,12 +1,14 @@
 // Shadow-ray transmittance against quadrature: along rays through the sample
-// cloud (a heterogeneous VDB grid, vdb_samples/cloud.vdb), the mean of the
+// cloud (a heterogeneous VDB grid, vdb_samples/cloud.vdb), the mean of each
 // unbiased estimator (residual ratio tracking against each block's density
-// bounds) must equal exp(-k integral of the density), the integral taken by a
-// fine midpoint rule over the trilinear density itself; and the majorant
-// segments must bound the density from above and below.
+// bounds; unbiased ray marching) must equal exp(-k integral of the density),
+// the integral taken by a fine midpoint rule over the trilinear density
+// itself; unbiased ray marching must be the quieter of the two; and the
+// majorant segments must bound the density from above and below.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -42,7 +44,8 @@ CloudRays cloudRays() {
     return c;
 }
 
-TEST(Transmittance, RatioTrackingMatchesQuadratureThroughAVdbCloud) {
+// Mean and variance of an estimator along each ray against quadrature.
+void checkAgainstQuadrature(TransmittanceEstimator estimator, std::vector<double>& variances) {
     CloudRays c = cloudRays();
     ThreadContext ctx(*c.scene);
     MediumQuery& q = *ctx.queries[0];
@@ -59,10 +62,30 @@ TEST(Transmittance, RatioTrackingMatchesQuadratureThroughAVdbCloud) {
         if (expected < 0.5) ++dense;
         Rng rng(5, uint64_t(i));
         SampleStats st;
-        for (int s = 0; s < 20000; ++s) st.add(regionTransmittance(ctx, 0, r, len, rng).x);
+        for (int s = 0; s < 20000; ++s) st.add(regionTransmittance(ctx, 0, r, len, rng, estimator).x);
         EXPECT_NEAR(st.mean(), expected, 4 * st.stdError() + 1e-4) << "ray " << i << " optical depth " << k.x * integral;
+        variances.push_back(st.variance());
     }
     EXPECT_GE(dense, 3);  // the rays do cross the cloud
+}
+
+TEST(Transmittance, RatioTrackingMatchesQuadratureThroughAVdbCloud) {
+    std::vector<double> v;
+    checkAgainstQuadrature(TransmittanceEstimator::RatioTracking, v);
+}
+
+TEST(Transmittance, UnbiasedMarchingMatchesQuadratureAndIsQuieterThanRatioTracking) {
+    std::vector<double> marching, tracking;
+    checkAgainstQuadrature(TransmittanceEstimator::UnbiasedMarching, marching);
+    checkAgainstQuadrature(TransmittanceEstimator::RatioTracking, tracking);
+    double sumMarching = 0, sumTracking = 0;
+    for (size_t i = 0; i < marching.size(); ++i) {
+        sumMarching += marching[i];
+        sumTracking += tracking[i];
+        std::printf("ray %zu: variance %.3g (marching), %.3g (ratio tracking)\n", i, marching[i], tracking[i]);
+    }
+    // The point of the estimator: the noise of next-event estimation's shadow rays.
+    EXPECT_LT(sumMarching, 0.5 * sumTracking);
 }
 
 TEST(Transmittance, MajorantSegmentsBoundTheDensityFromBothSides) {
