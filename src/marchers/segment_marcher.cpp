@@ -47,11 +47,11 @@ PathResult SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& 
     bool lightsCounted = false;
     int diffuseBounces = 0;
     for (int bounce = 0;; ++bounce) {
-        SurfaceHit h;
-        bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
-        float tLight = Infinity;
-        int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
-        float segEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+        const RaySegment seg = nextRaySegment(scene, ray);
+        const SurfaceHit& h = seg.surface;
+        const bool hit = seg.hitSurface;
+        const int light = seg.light;
+        const float segEnd = seg.tEnd;
         scratch(ctx).pathDepth = diffuseBounces;
         if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f};
         auto addSeen = [&](const Color& Le) {

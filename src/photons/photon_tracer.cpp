@@ -93,11 +93,11 @@ private:
         Color beta(1);  // throughput relative to the emitted power
         MediumPoint mp;
         while (true) {
-            SurfaceHit h;
-            bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
-            float tLight = Infinity;
-            int light = intersectSphereLights(scene, ray, 1e-4f * scene.sceneScale, hit ? h.t : Infinity, tLight);
-            float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+            const RaySegment seg = nextRaySegment(scene, ray);
+            const SurfaceHit& h = seg.surface;
+            const bool hit = seg.hitSurface;
+            const int light = seg.light;
+            const float tEnd = seg.tEnd;
 
             // Delta tracking to the next real collision; the photon is stored
             // there, then scatters with probability albedo.

@@ -22,11 +22,11 @@ FirstEvent traceFirstEvent(ThreadContext& ctx, const Ray& cameraRay, Rng& rng) {
     Color beta(1);
     MediumPoint mp;
     for (int bounce = 0; bounce <= scene.desc.render.maxSurfaceBounces; ++bounce) {
-        SurfaceHit h;
-        const bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
-        float tLight = Infinity;
-        const int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
-        const float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+        const RaySegment seg = nextRaySegment(scene, ray);
+        const SurfaceHit& h = seg.surface;
+        const bool hit = seg.hitSurface;
+        const int light = seg.light;
+        const float tEnd = seg.tEnd;
         bool collided = false;
         deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
             evalMedia(ctx, region, x, mp);
@@ -40,7 +40,7 @@ FirstEvent traceFirstEvent(ThreadContext& ctx, const Ray& cameraRay, Rng& rng) {
         });
         if (collided) return out;
         if (light >= 0) {
-            seen(ray.at(tLight));
+            seen(ray.at(tEnd));
             return out;
         }
         if (!hit) return out;

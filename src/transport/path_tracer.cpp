@@ -13,9 +13,9 @@ namespace vdbmarch {
 
 namespace {
 
-// Next-event estimation of the path: ratio tracking; sphere lights are also
-// hit by the path, a constant background only by the path, an environment
-// map by both.
+// Next-event estimation of the path: unbiased ray marching (transmittance.h);
+// sphere lights are also hit by the path, a constant background only by the
+// path, an environment map by both.
 DirectLightOptions nextEventOptions(const PathState& st, const float* lightWeights = nullptr) {
     return {TransmittanceEstimator::UnbiasedMarching, true, false, st.pointLightsByPhotons, lightWeights};
 }
@@ -52,11 +52,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     int surfaceBounces = 0;
     MediumPoint mp;
     while (true) {
-        SurfaceHit h;
-        bool hit = scene.surfaceSet->intersect(ray, 0.f, Infinity, h);
-        float tLight = Infinity;
-        int light = intersectSphereLights(scene, ray, 0.f, hit ? h.t : Infinity, tLight);
-        float tEnd = light >= 0 ? tLight : (hit ? h.t : Infinity);
+        const RaySegment seg = nextRaySegment(scene, ray);
+        const SurfaceHit& h = seg.surface;
+        const bool hit = seg.hitSurface;
+        const int light = seg.light;
+        const float tEnd = seg.tEnd;
 
         // A guide may take this segment's free flight (path_guide.h); at
         // max_depth a collision could only end the path, so it is tracked.

@@ -6,8 +6,8 @@
 //    tentative collision (sigma_a L_e / sigma_maj), absorption / scattering /
 //    null chosen by their ratios;
 //  - next-event estimation to every light at every scattering vertex with
-//    ratio-tracking transmittance; sphere lights are also hit by the path and
-//    the two strategies meet by the power heuristic;
+//    unbiased ray-marching transmittance; sphere lights are also hit by the
+//    path and the two strategies meet by the power heuristic;
 //  - with a guide (path_guide.h), its free flights and directions instead
 //    wherever it takes them;
 //  - phase-mixture sampling, the shared surface event, Russian roulette

@@ -25,6 +25,16 @@ int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tM
     return best;
 }
 
+RaySegment nextRaySegment(const Scene& scene, const Ray& r) {
+    RaySegment seg;
+    seg.hitSurface = scene.surfaceSet->intersect(r, 0.f, Infinity, seg.surface);
+    const float tSurface = seg.hitSurface ? seg.surface.t : Infinity;
+    float tLight = Infinity;
+    seg.light = intersectSphereLights(scene, r, SphereLightRayOffset * scene.sceneScale, tSurface, tLight);
+    seg.tEnd = seg.light >= 0 ? tLight : tSurface;
+    return seg;
+}
+
 int regionAtRayStart(const Scene& scene, const Ray& r) {
     SurfaceHit h;
     if (!scene.surfaceSet->intersect(r, 0.f, Infinity, h)) return Scene::WorldRegion;

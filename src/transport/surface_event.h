@@ -48,4 +48,21 @@ int regionAtRayStart(const Scene& scene, const Ray& r);
 // Closest sphere light hit in (tMin, tMax); returns the light index or -1.
 int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tMax, float& t);
 
+// Sphere lights count from this far along a ray (times the scene scale), on
+// path and shadow rays alike: a photon leaving a light's surface never hits
+// that light again.
+constexpr float SphereLightRayOffset = 1e-4f;
+
+// What a path ray meets first: the closest surface, and a sphere light before
+// it. Every path loop (camera and continuation paths, the marchers' camera
+// rays, photons, the AOVs' first event) starts each segment here, so they
+// agree on what a ray hits.
+struct RaySegment {
+    SurfaceHit surface;
+    bool hitSurface = false;
+    int light = -1;         // the sphere light hit before any surface, or -1
+    float tEnd = Infinity;  // the light's hit, else the surface's, else Infinity
+};
+RaySegment nextRaySegment(const Scene& scene, const Ray& r);
+
 }  // namespace vdbmarch

@@ -24,7 +24,7 @@ bool walkShadowRay(const Scene& scene, int region, Ray r, float dist, Segment&& 
         SurfaceHit h;
         bool hit = scene.surfaceSet->intersect(r, 0.f, tLimit, h);
         float tLight;
-        if (intersectSphereLights(scene, r, 1e-4f * scene.sceneScale, hit ? h.t : tLimit, tLight) >= 0) return false;
+        if (intersectSphereLights(scene, r, SphereLightRayOffset * scene.sceneScale, hit ? h.t : tLimit, tLight) >= 0) return false;
         if (!segment(region, r, hit ? h.t : remaining)) return false;
         if (!hit) return true;
         const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
