@@ -23,14 +23,9 @@ struct ThreadContext {
     std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
     std::vector<Interval> intervals, shadowIntervals, scratch;
     std::vector<MajorantSegment> majorants;
-    // Shadow rays' unbiased ray marching (transmittance.cpp): the ray's
-    // blocks, and per optical-depth estimate its running state.
+    // Shadow rays' unbiased ray marching (transmittance.cpp): the blocks
+    // not sampled yet, and the optical-depth estimates.
     std::vector<MajorantSegment> shadowMajorants;
-    struct MarchEstimate {
-        double depth = 0, next = 0;
-        int taken = 0;
-    };
-    std::vector<MarchEstimate> marchEstimates;
     std::vector<double> marchDepths;
     // Distance sampling towards lights along the current path segment
     // (light_distance.h), and next-event weights per light.

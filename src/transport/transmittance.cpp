@@ -110,15 +110,18 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
 // Unbiased ray marching (Kettunen et al. 2021) of one medium over [0, tEnd).
 // The optical depth is estimated by stratified samples placed in proportion
 // to each block's residual bound (max - min, importance sampling), residual to
-// the block's minimum, whose share is exact; the strata hold about
-// MarchedDepthPerStratum of residual optical depth each. The series of
-// core/power_series.h turns order + 1 such estimates into an unbiased
-// transmittance whose noise is close to stepped marching's exp(-tau), and
-// most shadow rays need one estimate (order 0 with probability SeriesPZero).
-// Both constants measured (0.5-4 per stratum, 0.75 and 0.9: BENCHMARKS.md).
+// the block's minimum, whose share is exact. The blocks are walked lazily in
+// pools of about MarchedPoolDepth of residual optical depth, each cut into
+// strata of at most MarchedDepthPerStratum, so roulette ends a deep ray's
+// walk early. The series of core/power_series.h turns order + 1 such
+// estimates into an unbiased transmittance whose noise is close to stepped
+// marching's exp(-tau); most shadow rays need one estimate (order 0 with
+// probability SeriesPZero). Constants measured (0.5-4 per stratum, 0.75 and
+// 0.9: BENCHMARKS.md).
 constexpr double MarchedDepthPerStratum = 1.0;
-constexpr int MaxStrata = 4096;  // absurd majorants: fewer strata, still unbiased
+constexpr double MarchedPoolDepth = 4.0;
 constexpr double SeriesPZero = 0.75;
+constexpr int MaxStrataPerPool = 4096;  // absurd majorants: wider strata, still unbiased
 
 Color marchedTransmittance(ThreadContext& ctx, int mi, const Ray& r, float tEnd, Rng& rng) {
     const Medium& m = *ctx.scene.media[size_t(mi)];
@@ -133,69 +136,76 @@ Color marchedTransmittance(ThreadContext& ctx, int mi, const Ray& r, float tEnd,
     }
     const float kMax = maxComponent(k), kMin = minComponent(k);
     if (!(kMax > 0)) return Color(1);
-    auto& segs = ctx.shadowMajorants;
-    segs.clear();
-    double control = 0, residual = 0;
-    forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& s) {
-        if (!(s.t1 > s.t0)) return true;
-        const float lo = std::max(0.f, std::min(s.minDensity, s.maxDensity));
-        control += double(lo) * (double(s.t1) - s.t0);
-        residual += (double(s.maxDensity) - lo) * (double(s.t1) - s.t0);
-        segs.push_back({s.t0, s.t1, s.maxDensity, lo});
-        return true;
-    });
-    if (!(residual > 0)) {  // constant blocks only: exact
-        Color T(1);
-        for (int c = 0; c < 3; ++c)
-            if (k[c] > 0 && control > 0) T[c] = float(std::exp(-double(k[c]) * control));
-        return T;
-    }
     const SeriesOrder dist(SeriesPZero);
     const int order = dist.sample(rng.uniformDouble());
     const int n = order + 1;
-    const int strata = int(std::min<double>(MaxStrata, std::ceil(double(kMax) * residual / MarchedDepthPerStratum)));
-    const double delta = residual / strata;  // residual mass per stratum
-    // Per estimate: its depth so far, the index and CDF position of its next
-    // sample (one jittered sample per stratum).
-    auto& est = ctx.marchEstimates;
-    est.assign(size_t(n), {});
-    for (auto& e : est) e.next = rng.uniformDouble() * delta;
-    size_t lastResidual = 0;
-    for (size_t i = 0; i < segs.size(); ++i)
-        if (segs[i].maxDensity > segs[i].minDensity) lastResidual = i;
+    auto& depth = ctx.marchDepths;  // per estimate: its residual depth so far
+    depth.assign(size_t(2 * n), 0.0);
+    auto& pool = ctx.shadowMajorants;  // segments with residual, not yet sampled
+    pool.clear();
+    double poolMass = 0, control = 0;
+    // Samples every estimate over the pool: M strata of equal residual mass,
+    // one jittered sample each, mapped to t through the pool's segments.
+    auto samplePool = [&]() {
+        const int strata = int(std::min<double>(MaxStrataPerPool,
+                                                std::ceil(double(kMax) * poolMass / MarchedDepthPerStratum)));
+        const double width = poolMass / strata;
+        for (int j = 0; j < n; ++j) {
+            size_t seg = 0;
+            double segStart = 0;  // residual mass before pool[seg]
+            for (int i = 0; i < strata; ++i) {
+                const double c = (i + rng.uniformDouble()) * width;
+                while (seg + 1 < pool.size() &&
+                       c >= segStart + (double(pool[seg].maxDensity) - pool[seg].minDensity) *
+                                           (double(pool[seg].t1) - pool[seg].t0)) {
+                    segStart += (double(pool[seg].maxDensity) - pool[seg].minDensity) * (double(pool[seg].t1) - pool[seg].t0);
+                    ++seg;
+                }
+                const MajorantSegment& s = pool[seg];
+                const double lo = s.minDensity, span = double(s.maxDensity) - lo;
+                const double t = std::min(double(s.t1), s.t0 + (c - segStart) / span);
+                ++ctx.counters.shadowSamples;
+                depth[size_t(j)] += (double(q.density(r.at(float(t)))) - lo) / span * width;
+            }
+        }
+        pool.clear();
+        poolMass = 0;
+    };
     // Roulette on the first estimate's depth in the least attenuated
     // channel: past RouletteThreshold of the light, the ray goes on with
     // probability exp(-(depth - paid)); the survivor's weight keeps it unbiased.
-    const double paidFloor = -std::log(double(RouletteThreshold));
-    double paid = paidFloor, weight = 1, controlSoFar = 0, cdf = 0;
-    for (size_t i = 0; i < segs.size(); ++i) {
-        const MajorantSegment& s = segs[i];
-        const double len = double(s.t1) - s.t0, lo = s.minDensity, span = double(s.maxDensity) - lo;
-        controlSoFar += lo * len;
-        if (span > 0) {
-            const double end = cdf + span * len;
-            for (auto& e : est) {
-                while (e.taken < strata && (e.next < end || i == lastResidual)) {
-                    const double t = std::min(double(s.t1), s.t0 + (e.next - cdf) / span);
-                    ++ctx.counters.shadowSamples;
-                    e.depth += (double(q.density(r.at(float(t)))) - lo) / span * delta;
-                    ++e.taken;
-                    e.next = (e.taken + rng.uniformDouble()) * delta;
-                }
-            }
-            cdf = end;
+    double paid = -std::log(double(RouletteThreshold)), weight = 1;
+    auto roulette = [&]() {
+        const double d = double(kMin) * (control + depth[0]);
+        if (!(kMin > 0) || d <= paid) return true;
+        const double survive = std::exp(-(d - paid));
+        paid = d;
+        if (rng.uniformDouble() >= survive) return false;
+        weight /= survive;
+        return true;
+    };
+    bool ended = false;
+    forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& s) {
+        if (!(s.t1 > s.t0)) return true;
+        const double len = double(s.t1) - s.t0;
+        const float lo = std::max(0.f, std::min(s.minDensity, s.maxDensity));
+        control += double(lo) * len;
+        if (s.maxDensity > lo) {
+            pool.push_back({s.t0, s.t1, s.maxDensity, lo});
+            poolMass += (double(s.maxDensity) - lo) * len;
+            if (double(kMax) * poolMass < MarchedPoolDepth) return true;
+            samplePool();
         }
-        const double depth = double(kMin) * (controlSoFar + est[0].depth);
-        if (kMin > 0 && depth > paid) {
-            const double survive = std::exp(-(depth - paid));
-            paid = depth;
-            if (rng.uniformDouble() >= survive) return Color(0);
-            weight /= survive;
+        if (!roulette()) {
+            ended = true;
+            return false;
         }
-    }
-    ctx.marchDepths.resize(size_t(2 * n));
-    double* d = ctx.marchDepths.data();
-    for (int j = 0; j < n; ++j) d[j] = control + est[size_t(j)].depth;
+        return true;
+    });
+    if (ended) return Color(0);
+    if (!pool.empty()) samplePool();
+    double* d = depth.data();
+    for (int j = 0; j < n; ++j) d[j] += control;
     return powerSeriesTransmittance(d, order, k, dist, d + n) * float(weight);
 }
 

@@ -10,7 +10,6 @@
 
 #include <openvdb/openvdb.h>
 #include <openvdb/io/GridDescriptor.h>
-#include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tree/LeafManager.h>
@@ -39,7 +38,6 @@ namespace {
 using FloatTree = openvdb::FloatTree;
 using LeafT = FloatTree::LeafNodeType;
 using BoolTree = openvdb::BoolTree;
-using VdbRay = openvdb::math::Ray<double>;
 
 std::string gridTypeName(const openvdb::GridBase& g) {
     std::string t = g.valueType();
@@ -278,11 +276,6 @@ private:
     openvdb::tree::ValueAccessor<const openvdb::Int32Tree> mBlockIndex;
     const float* mBlock = nullptr;            // cached block for mBlockOrigin
     openvdb::Coord mBlockOrigin{INT32_MIN, 0, 0};
-    // Walks the block index's tiles, starting at the root's children and
-    // descending: large empty nodes are skipped whole.
-    openvdb::math::VolumeHDDA<openvdb::Int32Tree, VdbRay, openvdb::Int32Tree::RootNodeType::ChildNodeType::LEVEL>
-        mHdda;
-    std::vector<VdbRay::TimeSpan> mSpans;
 };
 
 class VdbMedium final : public Medium {
@@ -534,48 +527,68 @@ void VdbQuery::walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit) {
     // Nudge exactly-zero components so the DDA's 1/dir stays finite.
     for (int a = 0; a < 3; ++a)
         if (dir[a] == 0) dir[a] = 1e-30;
-    VdbRay ray(eye, dir, t0, t1);
-    mHdda.hits(ray, mBlockIndex, mSpans);
-    // The hierarchical DDA finds spans of leaf-sized blocks; within them walk
-    // the blocks with a 3D-DDA on the 8-voxel lattice and keep only the part
-    // of the ray inside each block's tight box of non-zero stencils.
+    // Two nested 3D-DDAs (Amanatides & Woo) in index space: over the block
+    // index's level-1 nodes (128 voxels a side), absent ones empty and skipped
+    // whole, and within each present node over its 8^3 blocks, keeping only
+    // the part of the ray inside each block's tight box of non-zero stencils.
+    // Lazy: visit returning false ends the walk where it is (a collision,
+    // a shadow ray ended by roulette), with nothing computed beyond.
+    using IndexNode = openvdb::Int32Tree::RootNodeType::ChildNodeType::ChildNodeType;
     const openvdb::Vec3d inv(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
-    for (const auto& span : mSpans) {
-        double s0 = std::max(span.t0, t0), s1 = std::min(span.t1, t1);
-        if (!(s1 > s0)) continue;
-        // Block containing the span's midpoint start, then step block to block.
-        openvdb::Vec3d p = eye + dir * (s0 + 1e-9 * (s1 - s0));
+    struct Dda {
         int cell[3], step[3];
         double tNext[3], tDelta[3];
-        for (int a = 0; a < 3; ++a) {
-            cell[a] = fastFloor(p[a]) & ~7;
-            step[a] = dir[a] > 0 ? 8 : -8;
-            double boundary = dir[a] > 0 ? cell[a] + 8 : cell[a];
-            tNext[a] = (boundary - eye[a]) * inv[a];
-            tDelta[a] = 8 * std::fabs(inv[a]);
-        }
-        double tCur = s0;
-        while (tCur < s1) {
-            int axis = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
-            double tExit = std::min(tNext[axis], s1);
-            int32_t id = mBlockIndex.getValue(openvdb::Coord(cell[0], cell[1], cell[2]));
-            if (id > 0) {
-                uint32_t box = mMedium.mBlocks.tightBox[size_t(id - 1)];
-                double a = tCur, b = tExit;
-                for (int ax = 0; ax < 3 && a < b; ++ax) {
-                    double lo = cell[ax] + double((box >> (4 * ax)) & 15);
-                    double hi = cell[ax] + double((box >> (12 + 4 * ax)) & 15);
-                    double ta = (lo - eye[ax]) * inv[ax], tb = (hi - eye[ax]) * inv[ax];
-                    if (ta > tb) std::swap(ta, tb);
-                    a = std::max(a, ta);
-                    b = std::min(b, tb);
-                }
-                if (b > a && !visit(a, b, size_t(id - 1))) return;
+        // The cell of `size` voxels holding the ray just after t (tEnd: the
+        // walk's end, for the nudge), and the times of its faces ahead.
+        void init(const openvdb::Vec3d& eye, const openvdb::Vec3d& dir, const openvdb::Vec3d& inv, double t,
+                  double tEnd, int size) {
+            const openvdb::Vec3d p = eye + dir * (t + 1e-9 * (tEnd - t));
+            for (int a = 0; a < 3; ++a) {
+                cell[a] = fastFloor(p[a]) & ~(size - 1);
+                step[a] = dir[a] > 0 ? size : -size;
+                const double boundary = dir[a] > 0 ? cell[a] + size : cell[a];
+                tNext[a] = (boundary - eye[a]) * inv[a];
+                tDelta[a] = size * std::fabs(inv[a]);
             }
-            tCur = tNext[axis];
-            cell[axis] += step[axis];
-            tNext[axis] += tDelta[axis];
         }
+        int axis() const { return tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2); }
+        // Time of leaving the current cell; steps to the next.
+        double advance() {
+            const int a = axis();
+            const double t = tNext[a];
+            cell[a] += step[a];
+            tNext[a] += tDelta[a];
+            return t;
+        }
+    };
+    Dda outer, inner;
+    outer.init(eye, dir, inv, t0, t1, int(IndexNode::DIM));
+    double tNode = t0;
+    while (tNode < t1) {
+        const double nodeExit = std::min(outer.tNext[outer.axis()], t1);
+        if (mBlockIndex.probeConstNode<IndexNode>(openvdb::Coord(outer.cell[0], outer.cell[1], outer.cell[2]))) {
+            inner.init(eye, dir, inv, tNode, nodeExit, 8);
+            double tCur = tNode;
+            while (tCur < nodeExit) {
+                const double tExit = std::min(inner.tNext[inner.axis()], nodeExit);
+                const int32_t id = mBlockIndex.getValue(openvdb::Coord(inner.cell[0], inner.cell[1], inner.cell[2]));
+                if (id > 0) {
+                    const uint32_t box = mMedium.mBlocks.tightBox[size_t(id - 1)];
+                    double a = tCur, b = tExit;
+                    for (int ax = 0; ax < 3 && a < b; ++ax) {
+                        double lo = inner.cell[ax] + double((box >> (4 * ax)) & 15);
+                        double hi = inner.cell[ax] + double((box >> (12 + 4 * ax)) & 15);
+                        double ta = (lo - eye[ax]) * inv[ax], tb = (hi - eye[ax]) * inv[ax];
+                        if (ta > tb) std::swap(ta, tb);
+                        a = std::max(a, ta);
+                        b = std::min(b, tb);
+                    }
+                    if (b > a && !visit(a, b, size_t(id - 1))) return;
+                }
+                tCur = inner.advance();
+            }
+        }
+        tNode = outer.advance();
     }
 }
 
