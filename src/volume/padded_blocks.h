@@ -25,7 +25,7 @@ struct PaddedBlocks {
     // One level-1 tile (an 8^3 block) per block of the grid's topology dilated
     // by one voxel (trilinear lookups reach the +1 neighbours): block id + 1
     // where the padded values are not all zero, 0 where they are. Every tile is
-    // active, so OpenVDB's hierarchical DDA walks exactly these blocks; tiles
+    // active; the media's block walk (vdb_medium.cpp) visits these tiles; tiles
     // cost no leaf (an Int32 leaf per block weighed as much as the grid).
     openvdb::Int32Tree index{0};
     // Per block id: its Size values (x-major, z fastest), the cells (0..7 per

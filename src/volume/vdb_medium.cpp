@@ -1,6 +1,6 @@
 // VDB density media: loading (with sanitising), trilinear sampling in index
-// space, and empty-space skipping with OpenVDB's hierarchical DDA over a
-// dilated copy of the active topology. One of the few files that include
+// space, and empty-space skipping by a two-level 3D-DDA over an index of
+// the dilated active topology's blocks. One of the few files that include
 // OpenVDB headers.
 #include <algorithm>
 #include <cmath>
