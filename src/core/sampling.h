@@ -97,6 +97,9 @@ public:
         const double delta = double(dot(oc, d));
         return falloffRange(delta, std::max(double(length(oc - d * float(delta))), double(minDistance)), a, b);
     }
+    // The integral of 1 / r^2 over [a, b] (a point source's unoccluded
+    // irradiance summed along the interval, per unit intensity).
+    float inverseSquareIntegral() const { return mValid ? float((mThetaB - mThetaA) / mD) : 0.f; }
     // Density of sample() at t; 0 outside [a, b].
     float pdf(float t) const {
         if (!mValid || !(t >= mA && t <= mB)) return 0.f;

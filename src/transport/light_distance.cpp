@@ -1,5 +1,6 @@
 #include "transport/light_distance.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "transport/direct_light.h"
@@ -130,42 +131,62 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
         EquiangularSampler s(ray.o, ray.d, c, t0, t1, rMin);
         if (s.valid()) ctx.lightDistances.push_back({int(i), s});
     }
+    // Several lights: one distance sample per segment, for a light chosen
+    // in proportion to its unoccluded single scattering along the segment
+    // (intensity times the integral of 1/r^2), so that a scene with many
+    // spots casts one shadow ray per segment, not one per spot.
+    if (ctx.lightDistances.size() > 1) {
+        double sum = 0;
+        for (ThreadContext::LightDistance& ld : ctx.lightDistances) {
+            const Light& light = scene.lights[size_t(ld.light)];
+            const Color intensity = light.isSphere() ? light.desc().power * (1 / (4 * Pi)) : light.desc().intensity;
+            ld.choice = std::max(average(intensity), 0.f) * ld.sampler.inverseSquareIntegral();
+            sum += double(ld.choice);
+        }
+        for (ThreadContext::LightDistance& ld : ctx.lightDistances)
+            ld.choice = sum > 0 ? float(double(ld.choice) / sum) : 1.f / float(ctx.lightDistances.size());
+    }
     seg.active = !ctx.lightDistances.empty();
     return seg;
 }
 
 Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng) {
-    Color L(0);
-    MediumPoint mp;
-    for (const ThreadContext::LightDistance& ld : ctx.lightDistances) {
+    const std::vector<ThreadContext::LightDistance>& samplers = ctx.lightDistances;
+    if (samplers.empty()) return Color(0);
+    // The segment's light (prepareLightDistances chose the odds).
+    size_t k = 0;
+    if (samplers.size() > 1) {
         const float u = rng.uniform();
-        const float t = ld.sampler.sample(u);
-        const float pdf = ld.sampler.pdf(t);
-        if (!(pdf > 0)) continue;
-        const Vec3 x = seg.ray.at(t);
-        evalMedia(ctx, seg.region, x, mp);
-        if (!mp.scatters()) continue;
-        float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
-        if (!(w > 0) || !russianRoulette(w, rng, MisWeightRouletteThreshold)) continue;
-        // Light that ends here: the quiet unbiased estimator (transmittance.h).
-        const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng, TransmittanceEstimator::UnbiasedMarching);
-        if (isBlack(T)) continue;
-        DirectLightOptions o;
-        o.transmittance = TransmittanceEstimator::UnbiasedMarching;
-        o.misWithPathHits = true;  // a sphere light is also found by the phase-sampled path
-        o.sampleBackground = false;
-        o.onlyLight = ld.light;
-        const Color nee = directLight(ctx, seg.region, ScatterVertex::inMedium(x, seg.ray.d, mp.phase), rng, o);
-        L += T * mp.sigma_s * nee * (w / pdf);
+        for (float cdf = samplers[0].choice; k + 1 < samplers.size() && !(u < cdf); cdf += samplers[++k].choice) {
+        }
     }
-    return L;
+    const ThreadContext::LightDistance& ld = samplers[k];
+    const float t = ld.sampler.sample(rng.uniform());
+    const float pdf = ld.choice * ld.sampler.pdf(t);
+    if (!(pdf > 0)) return Color(0);
+    const Vec3 x = seg.ray.at(t);
+    MediumPoint mp;
+    evalMedia(ctx, seg.region, x, mp);
+    if (!mp.scatters()) return Color(0);
+    float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
+    if (!(w > 0) || !russianRoulette(w, rng, MisWeightRouletteThreshold)) return Color(0);
+    // Light that ends here: the quiet unbiased estimator (transmittance.h).
+    const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng, TransmittanceEstimator::UnbiasedMarching);
+    if (isBlack(T)) return Color(0);
+    DirectLightOptions o;
+    o.transmittance = TransmittanceEstimator::UnbiasedMarching;
+    o.misWithPathHits = true;  // a sphere light is also found by the phase-sampled path
+    o.sampleBackground = false;
+    o.onlyLight = ld.light;
+    const Color nee = directLight(ctx, seg.region, ScatterVertex::inMedium(x, seg.ray.d, mp.phase), rng, o);
+    return T * mp.sigma_s * nee * (w / pdf);
 }
 
 const float* trackingWeights(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp) {
     ctx.lightWeights.assign(ctx.scene.lights.size(), 1.f);
     const float pTrack = trackingDensity(ctx, seg, t, mp);
     for (const ThreadContext::LightDistance& ld : ctx.lightDistances)
-        ctx.lightWeights[size_t(ld.light)] = 1 - equiangularWeight(seg, ld.sampler.pdf(t), pTrack);
+        ctx.lightWeights[size_t(ld.light)] = 1 - equiangularWeight(seg, ld.choice * ld.sampler.pdf(t), pTrack);
     return ctx.lightWeights.data();
 }
 

@@ -5,11 +5,12 @@
 // seldom lands there: in a thin haze a spot's narrow beam holds a few
 // collisions in a hundred, and a collision close to a light inside a medium
 // brings a 1/d^2 firefly. So every path segment in a scattering region also
-// draws, for each such light, one point by the equiangular density over the
-// part of the segment the light reaches (a spot's cone, the scattering
-// media's bounds), and estimates that light's single scattering there; the
+// draws one point by the equiangular density over the part of the segment a
+// light reaches (a spot's cone, the scattering media's bounds), for one such
+// light chosen in proportion to its unoccluded single scattering along the
+// segment, and estimates that light's single scattering there; the
 // next-event estimate of the same light at a tracking collision takes the
-// complementary weight.
+// complementary weight (the choice's probability is part of the density).
 //
 // The two strategies' power-heuristic weights sum to one at every t, so the
 // sum is unbiased whatever densities the weights are computed from. The
@@ -43,12 +44,14 @@ struct LightDistanceSegment {
 
 // Sets up the samplers of the segment: one per point-like or sphere light
 // that reaches a scattering part of it (point-like lights left out when
-// `skipPointLights`, as next-event estimation leaves them).
+// `skipPointLights`, as next-event estimation leaves them), with the odds of
+// choosing each.
 LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
                                            bool skipPointLights);
 
-// One distance sample per prepared light: T(t) sigma_s(t) f L T_shadow w / pdf(t),
-// the light's single scattering along the segment weighted for MIS.
+// One distance sample, for one prepared light (chosen by its odds):
+// T(t) sigma_s(t) f L T_shadow w / pdf(t), the light's single scattering
+// along the segment weighted for MIS.
 Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng);
 
 // Per scene light, the weight of next-event estimation at a tracking

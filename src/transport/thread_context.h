@@ -32,6 +32,7 @@ struct ThreadContext {
     struct LightDistance {
         int light;
         EquiangularSampler sampler;
+        float choice = 1;  // probability that the segment samples this light
     };
     std::vector<LightDistance> lightDistances;
     std::vector<float> lightWeights;
