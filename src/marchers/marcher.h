@@ -9,6 +9,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "parse/method.h"
+#include "transport/path_tracer.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
@@ -16,19 +17,10 @@ namespace vdbmarch {
 class Scene;
 struct Illumination;
 
-struct PathResult {
-    Color L;              // radiance towards the camera
-    float transmittance;  // fraction of the background seen (alpha = 1 - this)
-    // The part of L after at most one scattering event (emission and
-    // unscattered light included): filled only when render.aovs asks for
-    // "direct" or "indirect" (docs/aovs.md), else zero.
-    Color direct{0};
-};
-
 class Marcher {
 public:
     virtual ~Marcher() = default;
-    virtual PathResult radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const = 0;
+    virtual PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const = 0;
 };
 
 // Methods the factory table implements, in the order `--method` lists them

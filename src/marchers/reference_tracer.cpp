@@ -25,16 +25,13 @@ public:
         if (mIllumination && mIllumination->cache) mGuide = makeCachePathGuide(s, *mIllumination->cache);
     }
 
-    PathResult radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
+    PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
         ++ctx.counters.cameraRays;
         const int region = regionAtRayStart(mScene, cameraRay);
         PathState start;
         start.guide = mGuide.get();
-        if (!mChromatic) {
-            PathRadiance p = tracePath(ctx, cameraRay, region, -1, rng, start);
-            return {p.L, p.transmittance, p.direct};
-        }
-        PathResult out{Color(0), 0.f};
+        if (!mChromatic) return tracePath(ctx, cameraRay, region, -1, rng, start);
+        PathRadiance out{Color(0), 0.f};
         for (int c = 0; c < 3; ++c) {
             PathRadiance p = tracePath(ctx, cameraRay, region, c, rng, start);
             out.L[c] = p.L[c];

@@ -24,10 +24,10 @@ SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumin
                        !mIllumination->cache->cells.empty();
 }
 
-PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
+PathRadiance SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
     if (!mTallyDirect) return trace(cameraRay, rng, ctx);
     scratch(ctx).direct = Color(0);
-    PathResult r = trace(cameraRay, rng, ctx);
+    PathRadiance r = trace(cameraRay, rng, ctx);
     r.direct = scratch(ctx).direct;
     return r;
 }
@@ -36,7 +36,7 @@ PathResult SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContex
 // background seen after at most one diffuse bounce, emission before the
 // second, a surface's next-event estimate at the first bounce, and what
 // inScattered() counts as direct at a march sample before the first bounce.
-PathResult SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
+PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
     const Scene& scene = mScene;
     ++ctx.counters.cameraRays;
     Color L(0), beta(1);

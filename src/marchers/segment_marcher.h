@@ -68,10 +68,10 @@ struct MarcherScratch final : ThreadContextExtension {
 class SegmentMarcher : public Marcher {
 public:
     SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination);
-    PathResult radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
+    PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
 
 private:
-    PathResult trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const;
+    PathRadiance trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const;
 
 protected:
     // Marches [0, tEnd) of the ray in `region`, adding to L and attenuating

@@ -363,7 +363,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                                     jy = rng.uniform();
                                 }
                                 Ray ray = scene.camera->generateRay(float(x) + jx, float(y) + jy);
-                                PathResult pr = marcher->radiance(ray, rng, ctx);
+                                PathRadiance pr = marcher->radiance(ray, rng, ctx);
                                 if (!isFinite(pr.L) || !std::isfinite(pr.transmittance)) {
                                     ++ctx.counters.nonFiniteSamples;  // dropped, never written
                                     continue;

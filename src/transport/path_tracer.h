@@ -41,12 +41,15 @@ struct PathState {
     const PathGuide* guide = nullptr;
 };
 
+// What a path brings back: a camera path's result (Marcher::radiance) and a
+// continuation's alike.
 struct PathRadiance {
-    Color L;              // radiance arriving at ray.o along -ray.d
-    float transmittance;  // fraction of the background seen straight (camera paths)
+    Color L;                  // radiance arriving at ray.o along -ray.d
+    float transmittance = 0;  // fraction of the background seen straight (camera paths; alpha = 1 - this)
     // The part of L after at most one scattering event in all (counting the
     // state's depth; emission and unscattered light included): the "direct"
-    // AOV. Zero for paths that start at depth >= 2.
+    // AOV (docs/aovs.md). Zero for paths that start at depth >= 2; marchers
+    // fill it only when render.aovs asks for "direct" or "indirect".
     Color direct;
 };
 

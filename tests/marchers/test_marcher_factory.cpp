@@ -41,7 +41,7 @@ TEST_P(MarcherFactoryMethods, MakesAMarcherThatAnswersARay) {
     Rng rng(1);
     SampleStats transmittance;
     for (int i = 0; i < 64; ++i) {
-        PathResult r = marcher->radiance(Ray{Vec3(0, 0, 3), Vec3(0, 0, -1)}, rng, ctx);
+        PathRadiance r = marcher->radiance(Ray{Vec3(0, 0, 3), Vec3(0, 0, -1)}, rng, ctx);
         ASSERT_TRUE(isFinite(r.L));
         ASSERT_GE(r.transmittance, 0.f);
         ASSERT_LE(r.transmittance, 1.f);
