@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -84,12 +85,31 @@ void removeTemporaryFilesOnInterrupt() {
 
 namespace {
 volatile std::sig_atomic_t gStopSignal = 0;
+// When the first stop signal came (CLOCK_MONOTONIC, ns; lock-free, so a
+// handler may touch it).
+std::atomic<long long> gStopSignalNs{0};
+static_assert(std::atomic<long long>::is_always_lock_free, "the signal handler needs a lock-free clock stamp");
+// One signal is often delivered twice: GNU timeout sends it to its child
+// and then to its whole process group, and Slurm signals every process of a
+// job step (a wrapper that forwards it adds a second). A repeat within this
+// window is the same request, not a second one.
+constexpr long long RepeatWindowNs = 1000000000LL;
+
+long long monotonicNs() {
+    timespec ts{};
+    ::clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
+    return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
+}
 
 extern "C" void requestStop(int sig) {
-    if (gStopSignal != 0) {  // the second one: stop now, as without checkpoints
+    const long long now = monotonicNs();
+    if (gStopSignal != 0) {
+        if (now - gStopSignalNs.load() < RepeatWindowNs) return;  // a duplicate delivery
+        // A second request: stop now, as without checkpoints.
         removeTempsAndReraise(sig == SIGUSR1 ? SIGTERM : sig);
         return;
     }
+    gStopSignalNs.store(now);
     gStopSignal = sig;
 }
 }  // namespace

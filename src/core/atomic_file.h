@@ -37,9 +37,12 @@ void removeTemporaryFilesOnInterrupt();
 
 // For renders that checkpoint: the first SIGINT, SIGTERM or SIGUSR1 only
 // records the signal (stopSignal() returns it; 0 before), so the render can
-// save its state at the next sample boundary and exit; a second one removes
-// the temporary files and dies, as removeTemporaryFilesOnInterrupt does
-// (a second SIGUSR1 dies by SIGTERM). SIGHUP keeps dying at once.
+// save its state at the next sample boundary and exit; a second one, a
+// second or more after the first, removes the temporary files and dies, as
+// removeTemporaryFilesOnInterrupt does (a second SIGUSR1 dies by SIGTERM).
+// Repeats within that second are one signal delivered twice (`timeout`
+// forwards a signal to its child and to its process group; Slurm signals
+// every process of a step). SIGHUP keeps dying at once.
 void stopGracefullyOnSignals();
 int stopSignal();
 

@@ -23,14 +23,17 @@ protected:
                 "-q"};
     }
     // Runs `args` in the background, waits for its first checkpoint at
-    // `checkpoint`, sends `signal`, and returns the shell's output, which
-    // ends with "status=<exit status>".
+    // `checkpoint`, sends `signal` (`times` times, 50 ms apart), and returns the
+    // shell's output, which ends with "status=<exit status>". The command
+    // runs under GNU timeout (runShell), which passes each signal on twice,
+    // to its child and to its process group, as wrappers on farms do.
     CliResult stopAfterFirstCheckpoint(const std::vector<std::string>& args, const std::string& checkpoint,
-                                       const char* signal) const {
+                                       const char* signal, int times = 1) const {
         std::string c = shellQuote(vdbmarchBinary());
         for (const std::string& a : args) c += " " + shellQuote(a);
-        c += " & pid=$!; for i in $(seq 500); do [ -f " + shellQuote(checkpoint) +
-             " ] && break; sleep 0.02; done; kill -" + signal + " $pid; wait $pid; echo status=$?";
+        c += " & pid=$!; for i in $(seq 500); do [ -f " + shellQuote(checkpoint) + " ] && break; sleep 0.02; done;";
+        for (int i = 0; i < times; ++i) c += str(i > 0 ? " sleep 0.05;" : "", " kill -", signal, " $pid;");
+        c += " wait $pid; echo status=$?";
         return runShell(c, work(""), mRoot.path());
     }
 };
@@ -65,6 +68,20 @@ TEST_F(CheckpointCli, SigtermSavesAndTheSameCommandResumesBitIdentical) {
         EXPECT_EQ(a[key], b[key]) << key;
     EXPECT_EQ(a["vdbmarch:spp"], "800");
     EXPECT_GT(std::stod(a["vdbmarch:renderSeconds"]), 0.0);
+}
+
+// One stop request delivered several times within a second (a wrapper that
+// forwards it, a process group signalled as a whole) is one request: the
+// render still saves its checkpoint and exits 75, where a second request
+// would end it at once.
+TEST_F(CheckpointCli, ASignalDeliveredSeveralTimesStillSaves) {
+    std::vector<std::string> args = renderArgs("part.exr", 2000);
+    args.insert(args.end(), {"--checkpoint", work("ck"), "--checkpoint-every", "0.1"});
+    const CliResult stopped = stopAfterFirstCheckpoint(args, work("ck"), "TERM", 3);
+    ASSERT_NE(stopped.out.find("status=75"), std::string::npos) << stopped.out << stopped.err;
+    EXPECT_TRUE(fs::exists(work("ck")));
+    EXPECT_FALSE(fs::exists(work("part.exr")));
+    EXPECT_TRUE(tempLeftovers(work("")).empty());
 }
 
 TEST_F(CheckpointCli, ForeignOrMissingCheckpointsAndBadOptionsAreRefused) {
