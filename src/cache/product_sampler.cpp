@@ -3,71 +3,57 @@
 #include <algorithm>
 #include <cmath>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
-#include "cache/sh.h"
-
 namespace vdbmarch {
 
 namespace {
 
-using PS = ProductDirectionSampler;
-constexpr float Dz = 2.f / PS::Nz;
-constexpr float Dphi = 2 * Pi / PS::Nphi;
-constexpr float BinSolidAngle = 4 * Pi / PS::Bins;
-constexpr int MaxCoeffs = shCount(PS::MaxOrder);
 // Largest float below 1: rescaled uniforms stay in [0, 1).
 constexpr float OneMinus = 0x1.fffffep-1f;
 
-// Bin centres and the SH basis there, once per process. Structure of arrays,
-// coefficient-major, so the per-build loops run over bins and vectorise.
-struct BinTable {
-    float x[PS::Bins], y[PS::Bins], z[PS::Bins];
-    // Y_k at -centre: the light seen when looking along the centre travels
-    // the other way (L is over the travel direction).
-    float Y[MaxCoeffs][PS::Bins];
-
-    BinTable() {
-        for (int b = 0; b < PS::Bins; ++b) {
-            float z0, z1, p0, p1;
-            PS::binBounds(b, z0, z1, p0, p1);
-            const float zc = 0.5f * (z0 + z1), pc = 0.5f * (p0 + p1), r = safeSqrt(1 - zc * zc);
-            x[b] = r * std::cos(pc);
-            y[b] = r * std::sin(pc);
-            z[b] = zc;
-            float basis[MaxCoeffs];
-            evalSh(PS::MaxOrder, Vec3(-x[b], -y[b], -z[b]), basis);
-            for (int k = 0; k < MaxCoeffs; ++k) Y[k][b] = basis[k];
-        }
-    }
+// A Henyey-Greenstein lobe of mean cosine g as three vMF lobes about its
+// axis, fitted by tools/fit_hg_vmf.py (least chi-square divergence, E[w^2]
+// of HG / mixture at most 1.002 up to g = 0.8, 1.012 at 0.9; a single lobe
+// of the same mean cosine gives 3.3 at g = 0.8, and the weights of a path's
+// vertices multiply). Rows are interpolated linearly in g; g = 0 is the
+// uniform lobe.
+struct HgFit {
+    float g;
+    float w[3];
+    float kappa[3];
+};
+constexpr HgFit HgAsVmf[] = {
+    {0.00f, {1.f, 0.f, 0.f}, {0.f, 0.f, 0.f}},
+    {0.20f, {0.02835f, 0.36256f, 0.60909f}, {2.9553f, 1.1401f, 0.26693f}},
+    {0.25f, {0.03631f, 0.37160f, 0.59209f}, {3.8027f, 1.4401f, 0.33405f}},
+    {0.30f, {0.04662f, 0.38161f, 0.57177f}, {4.7362f, 1.7522f, 0.40163f}},
+    {0.35f, {0.05955f, 0.39207f, 0.54838f}, {5.7883f, 2.0809f, 0.46997f}},
+    {0.40f, {0.07537f, 0.40243f, 0.52220f}, {7.004f, 2.4326f, 0.53952f}},
+    {0.45f, {0.09431f, 0.41216f, 0.49353f}, {8.4471f, 2.8162f, 0.6109f}},
+    {0.50f, {0.11657f, 0.42076f, 0.46267f}, {10.211f, 3.2447f, 0.68502f}},
+    {0.55f, {0.14231f, 0.42776f, 0.42993f}, {12.439f, 3.7373f, 0.76315f}},
+    {0.60f, {0.17169f, 0.43271f, 0.39560f}, {15.358f, 4.3234f, 0.84714f}},
+    {0.65f, {0.20484f, 0.43521f, 0.35994f}, {19.356f, 5.0514f, 0.93978f}},
+    {0.70f, {0.24195f, 0.43483f, 0.32322f}, {25.14f, 6.0049f, 1.0455f}},
+    {0.75f, {0.28330f, 0.43109f, 0.28562f}, {34.125f, 7.3421f, 1.1717f}},
+    {0.80f, {0.32951f, 0.42333f, 0.24716f}, {49.521f, 9.3949f, 1.3313f}},
+    {0.85f, {0.38205f, 0.41041f, 0.20755f}, {80.107f, 12.983f, 1.55f}},
+    {0.90f, {0.44430f, 0.38977f, 0.16593f}, {158.56f, 20.775f, 1.8883f}},
+    {0.95f, {0.52533f, 0.35425f, 0.12043f}, {518.24f, 48.195f, 2.5519f}},
+    {0.97f, {0.56918f, 0.33043f, 0.10039f}, {1257.9f, 91.982f, 3.1002f}},
+    {0.99f, {0.63116f, 0.28902f, 0.07983f}, {8762.5f, 389.68f, 4.3786f}},
 };
 
-const BinTable& binTable() {
-    static const BinTable table;
-    return table;
-}
-
-// out[b] (+)= w * hgPhase(cosB[b], g) over all bins. std::sqrt keeps the
-// loop scalar (errno semantics without -fno-math-errno), and the phase is
-// most of a build, so SSE2 does four bins at a time where it exists.
-void addHgRow(const float* cosB, float g, float w, bool accumulate, float* out) {
-    const float a = 1 + g * g, b = -2 * g, c = w * Inv4Pi * (1 - g * g);
-    int i = 0;
-#if defined(__SSE2__)
-    const __m128 va = _mm_set1_ps(a), vb = _mm_set1_ps(b), vc = _mm_set1_ps(c), tiny = _mm_set1_ps(1e-12f);
-    for (; i + 4 <= PS::Bins; i += 4) {
-        const __m128 d = _mm_add_ps(va, _mm_mul_ps(vb, _mm_loadu_ps(cosB + i)));
-        __m128 p = _mm_div_ps(vc, _mm_mul_ps(d, _mm_sqrt_ps(_mm_max_ps(d, tiny))));
-        if (accumulate) p = _mm_add_ps(p, _mm_loadu_ps(out + i));
-        _mm_storeu_ps(out + i, p);
-    }
-#endif
-    for (; i < PS::Bins; ++i) {
-        const float d = a + b * cosB[i];
-        const float p = c / (d * std::sqrt(std::max(d, 1e-12f)));
-        out[i] = accumulate ? out[i] + p : p;
+// The three lobes of HG(|g|) (about the axis, or against it for g < 0).
+void hgLobes(float g, float w[3], float kappa[3]) {
+    constexpr int Rows = int(sizeof(HgAsVmf) / sizeof(HgAsVmf[0]));
+    const float a = clamp(std::fabs(g), 0.f, HgAsVmf[Rows - 1].g);
+    int r = 0;
+    while (r + 2 < Rows && HgAsVmf[r + 1].g < a) ++r;
+    const HgFit &lo = HgAsVmf[r], &hi = HgAsVmf[r + 1];
+    const float t = clamp((a - lo.g) / (hi.g - lo.g), 0.f, 1.f);
+    for (int i = 0; i < 3; ++i) {
+        w[i] = lo.w[i] + t * (hi.w[i] - lo.w[i]);
+        kappa[i] = lo.kappa[i] + t * (hi.kappa[i] - lo.kappa[i]);
     }
 }
 
@@ -77,80 +63,71 @@ ProductDirectionSampler::ProductDirectionSampler(float defensive) : mEps(clamp(d
     mCdf[0] = 0;
 }
 
-int ProductDirectionSampler::binOf(const Vec3& w) {
-    const int iz = clamp(int((w.z + 1) * (0.5f * Nz)), 0, Nz - 1);
-    float phi = std::atan2(w.y, w.x);
-    if (phi < 0) phi += 2 * Pi;
-    const int ip = clamp(int(phi * (1 / Dphi)), 0, Nphi - 1);
-    return iz * Nphi + ip;
-}
-
-void ProductDirectionSampler::binBounds(int bin, float& z0, float& z1, float& phi0, float& phi1) {
-    const int iz = bin / Nphi, ip = bin % Nphi;
-    z0 = -1 + iz * Dz;
-    z1 = iz + 1 == Nz ? 1.f : z0 + Dz;
-    phi0 = ip * Dphi;
-    phi1 = phi0 + Dphi;
-}
-
-bool ProductDirectionSampler::build(int order, const float* coeffs, const PhaseMixture& phase,
-                                    const Vec3& rayDir) {
+bool ProductDirectionSampler::build(const PreparedLobes& light, const PhaseMixture& phase, const Vec3& rayDir) {
     mPhase = &phase;
     mRayDir = rayDir;
-    mTable = false;
-    if (phase.empty() || order < 0 || mEps >= 1) return false;
-    const BinTable& t = binTable();
-    const int n = shCount(std::min(order, MaxOrder));
+    mLobes = 0;
+    if (phase.empty() || mEps >= 1 || light.count == 0) return false;
+    // The phase function's stand-in: three lobes around rayDir (or against
+    // it) of the mixture's mean cosine (lobes picked by average(sigma_s), as
+    // PhaseMixture::pdf does).
+    float total = 0, gSum = 0;
+    for (int i = 0; i < phase.count; ++i) {
+        total += average(phase.sigmaS[i]);
+        gSum += average(phase.sigmaS[i]) * phase.g[i];
+    }
+    const float g = total > 0 ? gSum / total : 0.f;
+    float phaseW[3], phaseKappa[3], logPhase[3];
+    hgLobes(g, phaseW, phaseKappa);
+    for (int m = 0; m < 3; ++m)
+        logPhase[m] = phaseW[m] > 0 ? std::log(phaseW[m]) + VmfLobe::logNormalisation(phaseKappa[m]) : -INFINITY;
+    const Vec3 muG = g >= 0 ? rayDir : -1.f * rayDir;
 
-    // L at the bin centres (one matrix-vector product), clamped at zero; a
-    // NaN coefficient gives NaN here and max(0, NaN) = 0 drops the bin.
-    float value[Bins];
-    for (int b = 0; b < Bins; ++b) value[b] = coeffs[0] * t.Y[0][b];
-    for (int k = 1; k < n; ++k) {
-        const float c = coeffs[k];
-        for (int b = 0; b < Bins; ++b) value[b] += c * t.Y[k][b];
+    // Product of each light lobe with each phase lobe: one vMF lobe, whose
+    // mass is the integral of the product, W C_j C_m / C(kappa').
+    Vec3 v[MaxProductLobes];
+    float kappa[MaxProductLobes], logWeight[MaxProductLobes], top = -INFINITY;
+    int n = 0;
+    for (int j = 0; j < light.count; ++j)
+        for (int m = 0; m < 3; ++m) {
+            if (!(phaseW[m] > 0)) continue;
+            v[n] = light.mu[j] * light.kappa[j] + muG * phaseKappa[m];
+            kappa[n] = length(v[n]);
+            logWeight[n] = light.logWeightNorm[j] + logPhase[m] - VmfLobe::logNormalisation(kappa[n]);
+            if (!std::isfinite(logWeight[n]) || !std::isfinite(kappa[n])) continue;
+            top = std::max(top, logWeight[n]);
+            ++n;
+        }
+    // Lobes under 1e-4 of the largest are left out (their share goes to the
+    // others; the density stays that of the mixture sampled).
+    float sum = 0;
+    for (int i = 0; i < n; ++i) {
+        if (logWeight[i] < top - 9.2f) continue;
+        const float w = std::exp(logWeight[i] - top);
+        mLobe[mLobes++] = VmfLobe::make(kappa[i] > 0 ? v[i] / kappa[i] : Vec3(0, 0, 1), kappa[i], w);
+        sum += w;
     }
-    // Times the phase pdf at the centre (the lobes by average(sigma_s), as
-    // PhaseMixture::pdf); inlined per lobe so the loop over bins vectorises.
-    float cosB[Bins], ph[Bins];
-    for (int b = 0; b < Bins; ++b) cosB[b] = rayDir.x * t.x[b] + rayDir.y * t.y[b] + rayDir.z * t.z[b];
-    if (phase.count == 1) {
-        addHgRow(cosB, phase.g[0], 1, false, ph);
-    } else {
-        float total = 0;
-        for (int i = 0; i < phase.count; ++i) total += average(phase.sigmaS[i]);
-        for (int i = 0; i < phase.count; ++i) addHgRow(cosB, phase.g[i], average(phase.sigmaS[i]) / total, i > 0, ph);
+    if (mLobes == 0 || !(sum > 0) || !std::isfinite(sum)) {
+        mLobes = 0;
+        return false;
     }
-    for (int b = 0; b < Bins; ++b) value[b] = std::max(0.f, value[b]) * ph[b];
-    // Prefix sum in two levels: the Nz rows side by side (independent chains
-    // that vectorise, not one 128-long chain of dependent adds), then the row
-    // offsets.
-    float row[Nz][Nphi + 1], offset = 0;
-    for (int iz = 0; iz < Nz; ++iz) row[iz][0] = 0;
-    for (int ip = 0; ip < Nphi; ++ip)
-        for (int iz = 0; iz < Nz; ++iz) row[iz][ip + 1] = row[iz][ip] + value[iz * Nphi + ip];
-    for (int iz = 0; iz < Nz; ++iz) {
-        for (int ip = 0; ip < Nphi; ++ip) mCdf[iz * Nphi + ip + 1] = offset + row[iz][ip + 1];
-        offset += row[iz][Nphi];
+    for (int j = 0; j < mLobes; ++j) {
+        mLobe[j].weight /= sum;
+        mCdf[j + 1] = mCdf[j] + mLobe[j].weight;
     }
-    const float sum = mCdf[Bins];
-    if (!(sum > 0) || !std::isfinite(sum)) return false;
-    // The bin probabilities are the CDF steps, so sample() and pdf() read the
-    // same numbers.
-    mInvNorm = 1 / (sum * BinSolidAngle);
-    mTable = true;
+    mCdf[mLobes] = 1;
     return true;
 }
 
-float ProductDirectionSampler::tablePdf(const Vec3& wi) const {
-    if (!mTable) return 0;
-    const int b = binOf(wi);
-    return (mCdf[b + 1] - mCdf[b]) * mInvNorm;
+float ProductDirectionSampler::lobesPdf(const Vec3& wi) const {
+    float p = 0;
+    for (int j = 0; j < mLobes; ++j) p += mLobe[j].weight * mLobe[j].pdf(wi);
+    return p;
 }
 
 float ProductDirectionSampler::mixturePdf(const Vec3& wi, float phasePdf) const {
-    if (!mTable) return phasePdf;
-    return mEps * phasePdf + (1 - mEps) * tablePdf(wi);
+    if (mLobes == 0) return phasePdf;
+    return mEps * phasePdf + (1 - mEps) * lobesPdf(wi);
 }
 
 float ProductDirectionSampler::pdf(const Vec3& wi) const {
@@ -161,25 +138,20 @@ float ProductDirectionSampler::pdf(const Vec3& wi) const {
 ProductSample ProductDirectionSampler::sample(float u0, float u1, float u2) const {
     ProductSample s;
     if (!mPhase || mPhase->empty()) return s;
-    if (!mTable || u0 < mEps) {
+    if (mLobes == 0 || u0 < mEps) {
         // Phase component: u0 rescaled picks the lobe (PhaseMixture::sample).
-        const float v0 = mTable ? std::min(u0 / mEps, OneMinus) : u0;
+        const float v0 = mLobes > 0 ? std::min(u0 / mEps, OneMinus) : u0;
         Color unused(1);
         float phasePdf;
         s.wi = mPhase->sample(mRayDir, v0, u1, u2, unused, phasePdf);
-        s.from = mTable ? ProductSample::From::Phase : ProductSample::From::PhaseOnly;
+        s.from = mLobes > 0 ? ProductSample::From::Phase : ProductSample::From::PhaseOnly;
     } else {
-        // Table component: u0 rescaled against the CDF picks a bin with
-        // non-zero value (upper_bound skips empty bins), u1 and u2 the point.
+        // Lobe component: u0 rescaled against the CDF picks a lobe.
         const float v0 = std::min((u0 - mEps) / (1 - mEps), OneMinus);
-        const float target = std::min(v0 * mCdf[Bins], std::nextafter(mCdf[Bins], 0.f));
-        const int b = int(std::upper_bound(mCdf + 1, mCdf + Bins + 1, target) - (mCdf + 1));
-        float z0, z1, p0, p1;
-        binBounds(b, z0, z1, p0, p1);
-        const float z = clamp(z0 + u1 * (z1 - z0), -1.f, 1.f), phi = p0 + u2 * (p1 - p0);
-        const float r = safeSqrt(1 - z * z);
-        s.wi = Vec3(r * std::cos(phi), r * std::sin(phi), z);
-        s.from = ProductSample::From::Table;
+        int j = 0;
+        while (j + 1 < mLobes && !(v0 < mCdf[j + 1])) ++j;
+        s.wi = mLobe[j].sample(u1, u2);
+        s.from = ProductSample::From::Lobes;
     }
     // The density of the whole mixture at wi, from wi alone (as pdf() does).
     const float c = dot(mRayDir, s.wi);

@@ -1,33 +1,38 @@
-// Product sampling of a path continuation direction: phase function x cached
-// incident radiance (spherical harmonics), with a defensive mixture.
+// Product sampling of a path continuation direction: the phase function
+// times the cached incident radiance, held as a few von Mises-Fisher lobes
+// per cache cell (direction_lobes.h), with a defensive phase share.
 //
 // This goes beyond the paper: Tokuyoshi & Maruyama guide only the *distance*
-// along the camera ray with the cache (and mix that distance pdf defensively,
-// eq. 16). The issue asks for the same idea on the scattering direction: draw
-// wi from a tabulated approximation of
-//     p(dot(rayDir, wi)) * max(0, L(-wi))
-// (L over the light's travel direction w' = -wi, sh.h), mixed with plain phase
-// sampling so that every direction the phase function reaches keeps a pdf of
-// at least eps * phasePdf. The weight f / pdf is then bounded by 1 / eps (one
-// lobe) and the estimator stays unbiased for any coefficients, including SH
-// ringing below zero (clamped to zero in the table, covered by the phase part).
+// along the camera ray with the cache (eq. 16). Here the scattering direction
+// is drawn from
+//     eps p(dot(rayDir, wi)) + (1 - eps) sum_j c_j vMF(wi; mu'_j, kappa'_j),
+// where each lobe j of the cell's incident radiance (mean direction mu_j, the
+// way a path goes to find that light, concentration kappa_j) is multiplied
+// by each of three lobes m around rayDir that together stand in for the
+// phase function (a fit of Henyey-Greenstein by tools/fit_hg_vmf.py): the
+// product of two vMF lobes is a vMF lobe, kappa' mu' = kappa_j mu_j +
+// kappa_m mu_g, of mass C(kappa_j) C(kappa_m) / C(kappa') (C the
+// normalisation), so c_jm is the lobe's radiance times the phase lobe's
+// weight times that mass (the product of Herholz et al. 2019 and Open PGL,
+// with three lobes for the phase function: one lobe of the same mean cosine
+// misses a g = 0.8 peak, and the second moment of the weight phase / pdf
+// is 3.3 per vertex for light from everywhere, which multiplies along a
+// path; three give 1.002). The approximation
+// shapes only the density: the weight evaluates the phase function exactly
+// (f / pdf, at most 1 / eps for one lobe), and pdf() is the exact density of
+// the mixture, so next-event estimation weighs its light samples against it
+// by MIS and the estimator stays unbiased for any lobes. A band-3 SH table
+// could not hold a g = 0.8 lobe (its expansion peaks 4.4x too low and goes
+// negative); lobes can.
 //
-// Geometry: the camera ray travels along rayDir; wi is the direction the path
+// Geometry: the path arrives travelling along rayDir; wi is the direction it
 // continues in (light arrives travelling along -wi). The phase factor is
-// phase.pdf(dot(rayDir, wi)), exactly as PhaseMixture::sample(rayDir, ...)
-// draws wi in SegmentMarcher::inScattered; the weight uses phase.eval.
-//
-// The table: an equal-area grid over the sphere in world coordinates, z =
-// cos(theta) uniform in [-1, 1] (Nz rows) x phi uniform in [0, 2 pi) (Nphi
-// columns), so every bin has solid angle 4 pi / (Nz Nphi) and a uniform point
-// in (z, phi) inside a bin is uniform in solid angle. Bin values are the target
-// at the bin centre; the SH basis at the (fixed) bin centres is a static table,
-// so a build is one small matrix-vector product plus one phase evaluation per
-// bin. Everything lives in fixed-size arrays: no allocation per use.
+// phase.pdf(dot(rayDir, wi)), as PhaseMixture::sample(rayDir, ...) draws it.
 #pragma once
 
 #include <cstdint>
 
+#include "cache/direction_lobes.h"
 #include "core/math.h"
 #include "transport/phase.h"
 
@@ -36,8 +41,8 @@ namespace vdbmarch {
 struct ProductSample {
     enum class From : uint8_t {
         Phase,      // the defensive phase component drew it
-        Table,      // the product table drew it
-        PhaseOnly,  // no table (no light reaches the point, or eps = 1): plain phase sampling
+        Lobes,      // the product lobes drew it
+        PhaseOnly,  // no lobes (no light reaches the cell, or eps = 1): plain phase sampling
     };
     Vec3 wi;
     Color weight{0};  // phase.eval(dot(rayDir, wi)) / pdf per channel
@@ -47,60 +52,46 @@ struct ProductSample {
 
 class ProductDirectionSampler {
 public:
-    // Bands the table reads (16 coefficients); higher bands are ignored, which
-    // only changes the proposal, never the expected value.
-    static constexpr int MaxOrder = 3;
-    // 8 x 16 bins (0.098 sr each, about 18 degrees across). Measured with
-    // the VarianceAgainstPhaseSampling cases of test_product_sampler.cpp
-    // (variance relative to phase sampling at eps 0.3 / order-3 build time):
-    //   4 x 8:   0.11-0.30 /   53 ns
-    //   8 x 16:  0.045-0.155 / 240 ns
-    //   16 x 32: 0.033-0.115 / 1.0 us
-    // An order-3 expansion has no detail finer than ~45 degrees; 16 x 32
-    // mostly resolves the phase peak better, for 4x the build.
-    static constexpr int Nz = 8, Nphi = 16, Bins = Nz * Nphi;
     // Probability of the defensive phase component. It bounds the weight by
-    // 1 / eps for one lobe (3.3 here) whatever the cache says, which matters
-    // because the cached L is only an approximation of what the path finds.
-    // With an exact cache (the tests) variance is flat over 0.2-0.3 (0.2 is
-    // 8-20% lower at 8 x 16) and grows past 0.4; 0.3 takes the safer bound.
+    // 1 / eps for one lobe whatever the cache says, which matters because
+    // the lobes are fitted to a few photons and what a path finds differs.
     static constexpr float DefaultDefensive = 0.3f;
 
     explicit ProductDirectionSampler(float defensive = DefaultDefensive);
 
-    // Tabulates phase x max(0, L) for a camera ray travelling along rayDir
-    // (unit). coeffs: shCount(order) SH coefficients of L over the light's
-    // travel direction (sh.h). `phase` is kept by pointer: it must outlive the
-    // sampler's use. Returns whether a table was built; false (no positive
-    // radiance, non-finite coefficients, order < 0) means sample() falls back
+    // Prepares the product of the phase function for a path travelling along
+    // rayDir (unit) with a cell's light lobes (direction_lobes.h). `phase`
+    // is kept by pointer: it must outlive the sampler's use. Returns whether
+    // lobes were built; false (no lobe with light) means sample() falls back
     // to plain phase sampling.
-    bool build(int order, const float* coeffs, const PhaseMixture& phase, const Vec3& rayDir);
+    bool build(const PreparedLobes& light, const PhaseMixture& phase, const Vec3& rayDir);
 
-    // Draws wi from eps * phase + (1 - eps) * table with three uniforms in
-    // [0, 1): u0 picks the component (and, rescaled, the lobe or the bin), u1
-    // and u2 the direction within it. Deterministic in (u0, u1, u2).
+    // Draws wi from eps * phase + (1 - eps) * lobes with three uniforms in
+    // [0, 1): u0 picks the component (and, rescaled, the phase lobe or the
+    // product lobe), u1 and u2 the direction within it. Deterministic in
+    // (u0, u1, u2).
     ProductSample sample(float u0, float u1, float u2) const;
 
     // The density sample() reports for wi (bitwise the same value).
     float pdf(const Vec3& wi) const;
 
-    bool hasTable() const { return mTable; }
+    bool hasLobes() const { return mLobes > 0; }
+    int lobeCount() const { return mLobes; }
     float defensive() const { return mEps; }
-    // The table component's own density (0 without a table), for tests.
-    float tablePdf(const Vec3& wi) const;
-    // Bin of a direction, and the [z0, z1) x [phi0, phi1) ranges of a bin.
-    static int binOf(const Vec3& w);
-    static void binBounds(int bin, float& z0, float& z1, float& phi0, float& phi1);
+    // The product lobes' own density (0 without lobes), for tests.
+    float lobesPdf(const Vec3& wi) const;
 
 private:
     float mixturePdf(const Vec3& wi, float phasePdf) const;
 
     float mEps;
-    bool mTable = false;
+    int mLobes = 0;
     const PhaseMixture* mPhase = nullptr;
     Vec3 mRayDir{0, 0, 1};
-    float mInvNorm = 0;    // 1 / (total * binSolidAngle)
-    float mCdf[Bins + 1];  // running sum of the bin values, mCdf[0] = 0
+    // Light lobes x the phase function's three lobes.
+    static constexpr int MaxProductLobes = DirectionLobes::MaxLobes * 3;
+    VmfLobe mLobe[MaxProductLobes];
+    float mCdf[MaxProductLobes + 1];  // running sum of the lobe weights, mCdf[0] = 0, mCdf[mLobes] = 1
 };
 
 }  // namespace vdbmarch

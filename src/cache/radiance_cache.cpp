@@ -172,8 +172,17 @@ size_t RadianceCache::cellsAtLevel(int level) const {
     return n;
 }
 
+void RadianceCache::prepareLobes() {
+    preparedLobes.clear();
+    if (!directionLobes) return;
+    preparedLobes.resize(cells.size());
+    for (size_t c = 0; c < cells.size() && (c + 1) * size_t(DirectionLobes::Floats) <= lobes.size(); ++c)
+        preparedLobes[c] = DirectionLobes::prepare(cellLobes(c));
+}
+
 size_t RadianceCache::memoryBytes() const {
-    size_t bytes = (coefficients.size() + incident.size()) * sizeof(float) + cells.size() * sizeof(CacheCell);
+    size_t bytes = (coefficients.size() + lobes.size()) * sizeof(float) + cells.size() * sizeof(CacheCell) +
+                   preparedLobes.size() * sizeof(PreparedLobes);
     if (mIndex)
         for (const auto& t : mIndex->levels) bytes += t->memUsage();
     return bytes;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "cache/direction_lobes.h"
 #include "cache/sh.h"
 #include "core/math.h"
 #include "parse/scene_desc.h"
@@ -60,16 +61,17 @@ public:
     int levels = 1;
     std::vector<CacheCell> cells;
     std::vector<float> coefficients;  // coefficientCount() per cell
-    // Optional (never saved): SH coefficients, up to band incidentOrder, of
-    // the incident radiance of the photons that are not direct, i.e. of the
-    // light a continuation path finds beside next-event estimation, over the
-    // light's travel direction (no phase convolution). Product sampling of
-    // continuation directions reads them. incidentOrder < 0: none.
-    int incidentOrder = -1;
-    std::vector<float> incident;
-    const float* cellIncident(size_t cell) const {
-        return &incident[cell * size_t(shCount(incidentOrder))];
-    }
+    // Optional (never saved): per cell, DirectionLobes::Floats statistics of
+    // a few von Mises-Fisher lobes fitted to the directions of the photons
+    // that are not direct, i.e. of the light a continuation path finds
+    // beside next-event estimation (direction_lobes.h). Product sampling of
+    // continuation directions reads them. Empty: none.
+    bool directionLobes = false;
+    std::vector<float> lobes;
+    std::vector<PreparedLobes> preparedLobes;  // of `lobes`, per cell (prepareLobes())
+    const float* cellLobes(size_t cell) const { return &lobes[cell * size_t(DirectionLobes::Floats)]; }
+    // Reads `lobes` into preparedLobes, after they are estimated or refined.
+    void prepareLobes();
 
     int coefficientCount() const { return (info.shOrder + 1) * (info.shOrder + 1); }
     float cellSize(int level) const { return baseCell / float(1 << level); }

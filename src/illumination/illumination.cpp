@@ -72,6 +72,9 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
     if (needCache && !rq.cacheFile.empty()) {
         RadianceCache c = RadianceCache::load(rq.cacheFile);
         checkCacheMatchesScene(c, scene, rq.cacheFile, rq.force);
+        if (rq.cacheSettings.directionLobes)
+            warn(str(rq.cacheFile, ": a cache file holds no direction lobes (render.product_sampling); "
+                                   "continuation directions follow the phase function"));
         il.cache = std::make_unique<RadianceCache>(std::move(c));
         il.cacheLoaded = true;
         needCache = false;
@@ -186,14 +189,14 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     if (method == Method::GuidedPath) {  // the cache alone, as the paths' guide
         rq.cache = true;
         rq.cacheFile = options.cacheFile;
-        if (rs.productSampling) rq.cacheSettings.incidentOrder = 3;  // guided directions
+        if (rs.productSampling) rq.cacheSettings.directionLobes = true;  // guided directions
         return rq;
     }
     rq.cache = methodUsesCache(method, rs);
     if (rq.cache) rq.cacheFile = options.cacheFile;
-    // Product sampling of continuation directions reads the non-direct
-    // incident radiance (band 3), estimated beside eq. 27.
-    if (rq.cache && rs.li == LiSource::Path && rs.productSampling) rq.cacheSettings.incidentOrder = 3;
+    // Product sampling of continuation directions reads lobes fitted to the
+    // non-direct photons, beside eq. 27.
+    if (rq.cache && rs.li == LiSource::Path && rs.productSampling) rq.cacheSettings.directionLobes = true;
     // Only when the cache goes unread (an `else` above warned for every
     // cached method without product sampling, which loads the file).
     if (!rq.cache && !options.cacheFile.empty())

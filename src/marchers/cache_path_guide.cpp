@@ -28,7 +28,7 @@ class CachePathGuide final : public PathGuide {
 public:
     CachePathGuide(const Scene& scene, const RadianceCache& cache)
         : mScene(scene), mCache(cache), mBin(cache.cellSize(cache.levels - 1)),
-          mDirections(scene.desc.render.productSampling && cache.incidentOrder >= 0 && !cache.cells.empty()) {
+          mDirections(scene.desc.render.productSampling && cache.directionLobes && !cache.cells.empty()) {
         mRegionEmits.assign(scene.regions.size(), 0);
         mRegionConstant.assign(scene.regions.size(), 0);
         for (size_t r = 0; r < scene.regions.size(); ++r) {

@@ -19,9 +19,10 @@
 // T by ratio tracking, so the estimator is unbiased for any cache, in
 // heterogeneous VDB media too (docs/method.md).
 //
-// Directions. Phase x the cell's cached non-direct incident radiance with a
-// defensive phase share (ProductDirectionSampler), when the cache holds
-// incident radiance (render.product_sampling).
+// Directions. Phase x the cell's non-direct incident light (a few von
+// Mises-Fisher lobes fitted to the photons) with a defensive phase share
+// (ProductDirectionSampler), when the cache holds lobes
+// (render.product_sampling).
 #pragma once
 
 #include <memory>

@@ -31,7 +31,7 @@ public:
         PathState start;
         start.guide = mGuide.get();
         if (!mChromatic) return tracePath(ctx, cameraRay, region, -1, rng, start);
-        PathRadiance out{Color(0), 0.f};
+        PathRadiance out{Color(0), 0.f, Color(0)};
         for (int c = 0; c < 3; ++c) {
             PathRadiance p = tracePath(ctx, cameraRay, region, c, rng, start);
             out.L[c] = p.L[c];

@@ -20,7 +20,7 @@ SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumin
     for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
     mProductSampling = scene.desc.render.productSampling && mIllumination->li == LiSource::Path &&
-                       mIllumination->cache && mIllumination->cache->incidentOrder >= 0 &&
+                       mIllumination->cache && mIllumination->cache->directionLobes &&
                        !mIllumination->cache->cells.empty();
 }
 
@@ -53,24 +53,24 @@ PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext
         const int light = seg.light;
         const float segEnd = seg.tEnd;
         scratch(ctx).pathDepth = diffuseBounces;
-        if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f};
+        if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f, Color(0)};
         auto addSeen = [&](const Color& Le) {
             L += Le;
             if (mTallyDirect && diffuseBounces <= 1) scratch(ctx).direct += Le;
         };
         if (light >= 0) {
             if (!lightsCounted) addSeen(beta * scene.lights[size_t(light)].emittedRadiance());
-            return {L, 0.f};
+            return {L, 0.f, Color(0)};
         }
         if (!hit) {
             // The camera path seen straight (or through glass): the map as a backdrop.
             if (!lightsCounted)
                 addSeen(beta * (diffuseBounces == 0 ? scene.environment.radianceSeen(ray.d)
                                                      : scene.environment.radiance(ray.d)));
-            return {L, diffuseBounces > 0 ? 0.f : average(beta)};  // a diffuse surface is opaque
+            return {L, diffuseBounces > 0 ? 0.f : average(beta), Color(0)};  // a diffuse surface is opaque
         }
         ++ctx.counters.surfaceHits;
-        if (bounce >= scene.desc.render.maxSurfaceBounces) return {L, 0.f};
+        if (bounce >= scene.desc.render.maxSurfaceBounces) return {L, 0.f, Color(0)};
         const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
         const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
@@ -82,9 +82,9 @@ PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext
             // (what shadow rays miss): continue the path in the cosine-
             // sampled direction, marching the media it crosses, as a
             // scattering event of max_depth; lights were counted above.
-            if (++diffuseBounces >= scene.desc.render.maxDepth) return {L, 0.f};
+            if (++diffuseBounces >= scene.desc.render.maxDepth) return {L, 0.f, Color(0)};
             beta *= e.weight;
-            if (!russianRoulette(beta, rng)) return {L, 0.f};
+            if (!russianRoulette(beta, rng)) return {L, 0.f, Color(0)};
             lightsCounted = true;
         } else {
             beta *= e.weight;
@@ -108,8 +108,7 @@ bool MarcherScratch::buildProductSampler(const RadianceCache& cache, const Vec3&
     // The non-direct incident radiance there: what the path can find
     // beside next-event estimation (the direct light of delta lights is not
     // in it: a path never finds that).
-    const int order = std::min(cache.incidentOrder, ProductDirectionSampler::MaxOrder);
-    if (!productSampler.build(order, cache.cellIncident(size_t(cell)), mp.phase, rayDir)) return false;
+    if (!productSampler.build(cache.preparedLobes[size_t(cell)], mp.phase, rayDir)) return false;
     vertex.pathSampler = &productSampler;
     vertex.pathPdf = [](const void* s, const Vec3& wi) { return static_cast<const ProductDirectionSampler*>(s)->pdf(wi); };
     return true;

@@ -141,8 +141,8 @@ struct CacheSettings {
     bool adaptive = false;  // octree-like subdivision where photons are dense
     float minCell = 0;      // smallest adaptive cell, world units (0: automatic)
     // Not a scene key: set by the renderer when product sampling reads the
-    // cache's non-direct incident radiance (RadianceCache::incident); -1: none.
-    int incidentOrder = -1;
+    // directions of the cache's non-direct photons (RadianceCache::lobes).
+    bool directionLobes = false;
 };
 
 // An environment map (scene key "environment"): a lat-long EXR of the
