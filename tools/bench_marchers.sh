@@ -6,11 +6,14 @@
 # Environment: RES (default 80x60), BUDGETS (seconds, default 2,4,8,16).
 #
 # Reference: the transmittance marcher at 1024 samples per pixel (another
-# pixel seed, the same photon map). It has the same expectation as the three
-# methods (the same L_i estimate, the same photons), so the tables measure
-# what the methods differ in, their sampling noise at equal time. Their common bias against full light transport (the photon
-# map's kNN blur; diffuse surfaces lit directly only) is measured separately
-# against the path tracer where it converges (BENCHMARKS.md); where a delta
+# pixel seed, the same photon seed). It has the same expectation as the three
+# methods (the same L_i estimate: with the default render.li = "path",
+# shadow rays and continuation paths, and photons only for the caustics of
+# delta lights through refracting glass, which no path finds; those photons
+# are the same map, so their kNN blur is common to all), so the tables
+# measure what the methods differ in, their sampling noise at equal time.
+# Against the full truth, use tools/bench_yardstick.sh or vdbmarch bench
+# with a converged path-traced reference (BENCHMARKS.md); where a delta
 # light is seen through glass (exp1_point, exp2_collimated, fig4_caustic) the
 # path tracer cannot converge at all.
 set -euo pipefail
@@ -31,8 +34,9 @@ bench() {  # name scene [bench options...]
 }
 
 # The scene's photon seed (render.seed unless photons.seed is set): the
-# reference shares the methods' photon map, whose noise pattern no number of
-# samples per pixel averages out, and differs only in its pixel samples.
+# reference shares the methods' caustic photon map, whose noise pattern no
+# number of samples per pixel averages out, and differs only in its pixel
+# samples.
 photonSeed() {
   python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d.get("photons",{}).get("seed", d.get("render",{}).get("seed",0)))' "$1"
 }

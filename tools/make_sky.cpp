@@ -18,7 +18,6 @@ using namespace vdbmarch;
 
 namespace {
 
-constexpr double PiD = 3.14159265358979323846;
 
 Color mix(const Color& a, const Color& b, float t) { return a * (1 - t) + b * t; }
 

@@ -7,7 +7,6 @@ namespace vdbmarch {
 
 namespace {
 
-constexpr double PiD = 3.14159265358979323846;
 
 // Coefficients of the recurrence for Qbar_l^m = K_lm P_l^m / sin^m theta, a
 // polynomial in z whose magnitude stays O(1) (the raw P_m^m = (2m-1)!! would

@@ -11,6 +11,7 @@
 namespace vdbmarch {
 
 constexpr float Pi = 3.14159265358979323846f;
+constexpr double PiD = 3.14159265358979323846;
 constexpr float InvPi = 0.31830988618379067154f;
 constexpr float Inv4Pi = 0.07957747154594766788f;
 constexpr float Infinity = std::numeric_limits<float>::infinity();

@@ -197,8 +197,7 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // Product sampling of continuation directions reads lobes fitted to the
     // non-direct photons, beside eq. 27.
     if (rq.cache && rs.li == LiSource::Path && rs.productSampling) rq.cacheSettings.directionLobes = true;
-    // Only when the cache goes unread (an `else` above warned for every
-    // cached method without product sampling, which loads the file).
+    // A cache file that this method and render.li leave unread is named.
     if (!rq.cache && !options.cacheFile.empty())
         warn(str(options.cacheFile, ": method ", methodName(method), " with render.li = \"", liSourceName(rs.li),
                  "\" does not read the cache; ignored"));

@@ -1,5 +1,6 @@
 #include "parse/json_locate.h"
 
+#include <algorithm>
 #include <cctype>
 
 namespace vdbmarch {
@@ -96,6 +97,16 @@ void lineAndColumn(const std::string& text, size_t offset, size_t& line, size_t&
             lineStart = i + 1;
         }
     column = offset - lineStart + 1;
+}
+
+std::string caretExcerpt(const std::string& text, size_t offset) {
+    size_t line, col;
+    lineAndColumn(text, offset, line, col);
+    const size_t lineStart = std::min(offset, text.size()) + 1 - col;
+    const size_t lineEnd = text.find('\n', lineStart);
+    std::string excerpt = text.substr(lineStart, lineEnd == std::string::npos ? std::string::npos : lineEnd - lineStart);
+    if (excerpt.size() > 120) excerpt = excerpt.substr(0, 120) + "...";
+    return "\n    " + excerpt + "\n    " + std::string(col > 0 ? col - 1 : 0, ' ') + "^";
 }
 
 }  // namespace vdbmarch

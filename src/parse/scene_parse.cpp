@@ -21,9 +21,9 @@ namespace vdbmarch {
 
 namespace {
 
-// Line and column (1-based) of the start of the token that nlohmann's parser
-// rejected (its `byte` is one past the last character it read), plus the line.
-void lineColumn(const std::string& text, size_t byte, size_t& line, size_t& col, std::string& excerpt) {
+// Offset of the start of the token that nlohmann's parser rejected (its
+// `byte` is one past the last character it read).
+size_t rejectedToken(const std::string& text, size_t byte) {
     size_t pos = std::min(byte > 0 ? byte - 1 : 0, text.empty() ? 0 : text.size() - 1);
     auto isWordChar = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '+' || c == '-'; };
     if (!text.empty() && text[pos] == '"') {
@@ -37,11 +37,7 @@ void lineColumn(const std::string& text, size_t byte, size_t& line, size_t& col,
     } else if (!text.empty() && isWordChar(text[pos])) {
         while (pos > 0 && isWordChar(text[pos - 1])) --pos;
     }
-    lineAndColumn(text, pos, line, col);
-    size_t lineStart = pos + 1 - col;
-    size_t lineEnd = text.find('\n', lineStart);
-    excerpt = text.substr(lineStart, lineEnd == std::string::npos ? std::string::npos : lineEnd - lineStart);
-    if (excerpt.size() > 120) excerpt = excerpt.substr(0, 120) + "...";
+    return pos;
 }
 
 Mat4 parseTransform(const JsonReader& r) {
@@ -577,16 +573,15 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
     try {
         doc = Json::parse(text);
     } catch (const Json::parse_error& e) {
+        const size_t offset = rejectedToken(text, e.byte);
         size_t line, col;
-        std::string excerpt;
-        lineColumn(text, e.byte, line, col, excerpt);
+        lineAndColumn(text, offset, line, col);
         std::string what = e.what();
         size_t pos = what.find("parse error");
         std::string detail = pos == std::string::npos ? what : what.substr(pos);
         size_t colon = detail.find(": ");
         if (colon != std::string::npos) detail = detail.substr(colon + 2);
-        throw InputError(str(file, ":", line, ":", col, ": malformed JSON: ", detail, "\n    ", excerpt, "\n    ",
-                             std::string(col > 0 ? col - 1 : 0, ' '), "^"));
+        throw InputError(str(file, ":", line, ":", col, ": malformed JSON: ", detail, caretExcerpt(text, offset)));
     } catch (const Json::exception& e) {
         // Not a syntax error, and without a position: a number too large for
         // a double (found by fuzzing: "1E400" is out_of_range, not parse_error).
@@ -614,7 +609,7 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
         if (offset == std::string::npos) throw;
         size_t line, col;
         lineAndColumn(text, offset, line, col);
-        throw InputError(str(file, ":", line, ":", col, ": ", e.detail));
+        throw InputError(str(file, ":", line, ":", col, ": ", e.detail, caretExcerpt(text, offset)));
     }
 }
 

@@ -10,7 +10,6 @@ namespace vdbmarch {
 
 namespace {
 
-constexpr double PiD = 3.14159265358979323846;
 
 // ---------------------------------------------------------------------------
 // Target geometry

@@ -9,7 +9,6 @@
 namespace vdbmarch {
 
 namespace {
-constexpr double PiD = 3.14159265358979323846;
 }
 
 Environment::Environment(const EnvironmentDesc& desc, const std::string& what) {

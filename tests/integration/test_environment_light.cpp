@@ -19,7 +19,6 @@ namespace {
 
 using namespace test;
 
-constexpr double PiD = 3.14159265358979323846;
 
 // The sample cloud at 32x24 with multiple scattering and no lights of its own.
 std::vector<std::string> cloudOverrides(Method m, int spp, int seed) {

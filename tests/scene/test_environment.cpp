@@ -17,7 +17,6 @@ namespace {
 
 using namespace test;
 
-constexpr double PiD = 3.14159265358979323846;
 
 // A smooth sky brighter towards +Y, with a small bright "sun" block of texels.
 std::vector<Color> skyTexels(int w, int h, int sunX, int sunY, int sunSize, float sun) {

@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/math.h"
 #include "core/error.h"
 #include "image/image.h"
 #include "marchers/marcher.h"
@@ -42,7 +43,7 @@ namespace test {
 
 namespace fs = std::filesystem;
 
-constexpr double PiD = 3.14159265358979323846;
+using ::vdbmarch::PiD;
 
 // ---------------------------------------------------------------------------
 // Temporary folders and files

@@ -97,27 +97,18 @@ TEST(PhaseMixture, SamplerMatchesPdfChiSquare) {
     }
     // Expected counts by quadrature of the pdf over each cell; cells pooled
     // to at least 5 expected.
-    double chi2 = 0, pooledObs = 0, pooledExp = 0;
-    int dof = 0;
+    std::vector<double> expected(observed.size(), 0);
     for (int ic = 0; ic < nCos; ++ic) {
         const double a = -1 + 2.0 * ic / nCos, b = a + 2.0 / nCos;
         double mass = 0;
         const int q = 200;
         for (int k = 0; k < q; ++k) mass += m.pdf(float(a + (k + 0.5) * (b - a) / q)) * (b - a) / q;
         mass *= 2 * M_PI / nPhi;
-        for (int ip = 0; ip < nPhi; ++ip) {
-            pooledObs += observed[size_t(ic * nPhi + ip)];
-            pooledExp += mass * samples;
-            if (pooledExp >= 5) {
-                chi2 += (pooledObs - pooledExp) * (pooledObs - pooledExp) / pooledExp;
-                ++dof;
-                pooledObs = pooledExp = 0;
-            }
-        }
+        for (int ip = 0; ip < nPhi; ++ip) expected[size_t(ic * nPhi + ip)] = mass * samples;
     }
-    ASSERT_GT(dof, 100);
-    const double p = test::chiSquareQ(chi2, dof - 1);
-    EXPECT_GT(p, 1e-3) << "chi2 " << chi2 << " dof " << dof - 1;
+    const test::ChiSquare chi = test::pooledChiSquare(observed, expected, 5);
+    ASSERT_GT(chi.dof, 100);
+    EXPECT_GT(chi.p(), 1e-3) << "chi2 " << chi.chi2 << " dof " << chi.dof;
     // The weight f / pdf has mean 1 per channel under the sampler (f integrates to 1).
     const double mean = weightSum / samples, se = std::sqrt((weightSum2 / samples - mean * mean) / (samples - 1));
     EXPECT_NEAR(mean, 1.0, 4 * se);
