@@ -65,6 +65,13 @@ template <typename T>
 inline T clamp(T v, T lo, T hi) { return v < lo ? lo : (v > hi ? hi : v); }
 inline float safeSqrt(float v) { return std::sqrt(std::max(0.f, v)); }
 inline float radians(float deg) { return deg * (Pi / 180.f); }
+// 1 - cos of the angle between w and a unit axis, accurate for tiny angles
+// and for w a rounding away from unit length.
+inline float oneMinusCosTo(const Vec3& w, const Vec3& axis) {
+    float len = length(w), c = dot(w, axis) / len;
+    if (c <= 0) return 1 - c;
+    return lengthSquared(cross(w, axis)) / (len * len) / (1 + c);
+}
 
 // Orthonormal basis around a unit vector (Duff et al. 2017, branchless).
 inline void coordinateSystem(const Vec3& n, Vec3& s, Vec3& t) {

@@ -101,29 +101,7 @@ bool beamMissesBox(const Vec3& c, const Vec3& u, const Vec3& v, const Vec3& dir,
 }
 
 // ---------------------------------------------------------------------------
-// Spot falloff and its integral
-
-// The falloff of Light::sample (keep in step with it), written in t = 1 - cos
-// of the angle to the spot axis, with omcCone = 1 - cosCone and omcFalloff =
-// 1 - cosFalloffStart (both exact in float): equal in exact arithmetic, but
-// hair-thin cones keep their shape. omcFalloff >= omcCone: hard edge.
-template <typename T>
-T spotFalloff(T t, T omcCone, T omcFalloff) {
-    if (t >= omcCone) return 0;
-    if (t > omcFalloff) {
-        T s = (omcCone - t) / (omcCone - omcFalloff);
-        return s * s * (3 - 2 * s);  // smoothstep
-    }
-    return 1;
-}
-
-// 1 - cos of the angle between w and a unit axis, accurate for tiny angles
-// and for w a rounding away from unit length.
-float oneMinusCosTo(const Vec3& w, const Vec3& axis) {
-    float len = length(w), c = dot(w, axis) / len;
-    if (c <= 0) return 1 - c;
-    return lengthSquared(cross(w, axis)) / (len * len) / (1 + c);
-}
+// Spot falloff and its integral (spotFalloff: scene/lights.h)
 
 // 16-point Gauss-Legendre rule on [-1, 1] (Newton on P_16, computed once).
 // It integrates the smoothstep of a cosine (a degree-3 trigonometric

@@ -13,7 +13,8 @@ Light::Light(const LightDesc& d) : mDesc(d) {
             break;
         case LightDesc::Type::Spot:
             mCosCone = std::cos(radians(d.coneDeg));
-            mCosFalloffStart = std::cos(radians(d.coneDeg - d.falloffDeg));
+            mOmcCone = 1 - mCosCone;
+            mOmcFalloffStart = 1 - std::cos(radians(d.coneDeg - d.falloffDeg));
             break;
         case LightDesc::Type::CollimatedQuad: {
             // Dual basis so a point's (a, b) in h = center + a u + b v comes
@@ -51,13 +52,8 @@ bool Light::sample(const Vec3& x, float u1, float u2, LightSample& s) const {
         }
         case LightDesc::Type::Spot: {
             if (!towardsPoint(x, mDesc.position, s, d2)) return false;
-            float cosTheta = dot(-s.wi, mDesc.direction);
-            if (cosTheta <= mCosCone) return false;
-            float falloff = 1;
-            if (cosTheta < mCosFalloffStart) {
-                float t = (cosTheta - mCosCone) / (mCosFalloffStart - mCosCone);
-                falloff = t * t * (3 - 2 * t);  // smoothstep
-            }
+            const float falloff = spotFalloff(oneMinusCosTo(-s.wi, mDesc.direction), mOmcCone, mOmcFalloffStart);
+            if (!(falloff > 0)) return false;
             s.L = mDesc.intensity * (falloff / d2);
             return true;
         }

@@ -9,6 +9,21 @@
 
 namespace vdbmarch {
 
+// A spot light's falloff, written once for next-event estimation and photon
+// emission: 1 inside the inner cone, a smoothstep to 0 at the cone's edge.
+// In t = 1 - cos of the angle to the spot axis, with omcCone = 1 - cosCone
+// and omcFalloff = 1 - cosFalloffStart (both exact in float), so that
+// hair-thin cones keep their shape. omcFalloff >= omcCone: hard edge.
+template <typename T>
+T spotFalloff(T t, T omcCone, T omcFalloff) {
+    if (t >= omcCone) return 0;
+    if (t > omcFalloff) {
+        T s = (omcCone - t) / (omcCone - omcFalloff);
+        return s * s * (3 - 2 * s);  // smoothstep
+    }
+    return 1;
+}
+
 struct LightSample {
     Vec3 wi;     // unit, from the shaded point towards the light
     float dist;  // distance to the light along wi (Infinity: directional)
@@ -42,7 +57,8 @@ public:
 private:
     LightDesc mDesc;
     Color mRadiance;
-    float mCosCone = -1, mCosFalloffStart = -1;
+    float mCosCone = -1;                    // spot cone (reachInterval)
+    float mOmcCone = 2, mOmcFalloffStart = 2;  // 1 - the cone's and falloff start's cosines (spotFalloff)
     Vec3 mQuadNormal, mDualU, mDualV;  // collimated quad plane and dual basis
 };
 

@@ -40,18 +40,11 @@ public:
     // density over [tMin, tMax] and returns true. Gridded media return false
     // and are marched.
     virtual bool densityIntegral(const Ray& r, float tMin, float tMax, float& integral) { return false; }
-    // Appends, in increasing order, segments covering every point of [tMin,
-    // tMax] where the density may be non-zero, each with an upper bound of the
-    // density on it: per 8^3 block for VDB grids, constant for homogeneous media.
-    void majorantSegments(const Ray& r, float tMin, float tMax, std::vector<MajorantSegment>& out) {
-        forEachMajorant(r, tMin, tMax, [&](const MajorantSegment& s) {
-            out.push_back(s);
-            return true;
-        });
-    }
-    // The same segments, produced lazily: visit is called in increasing t
-    // until it returns false (a delta tracker stops at its first real
-    // collision without walking the rest of the ray).
+    // Segments covering every point of [tMin, tMax] where the density may be
+    // non-zero, each with an upper bound of the density on it (per 8^3 block
+    // for VDB grids, constant for homogeneous media), produced lazily: visit
+    // is called in increasing t until it returns false (a delta tracker
+    // stops at its first real collision without walking the rest of the ray).
     virtual void forEachMajorant(const Ray& r, float tMin, float tMax,
                                  const std::function<bool(const MajorantSegment&)>& visit) = 0;
 };
