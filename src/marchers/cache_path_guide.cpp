@@ -28,7 +28,8 @@ class CachePathGuide final : public PathGuide {
 public:
     CachePathGuide(const Scene& scene, const RadianceCache& cache)
         : mScene(scene), mCache(cache), mBin(cache.cellSize(cache.levels - 1)),
-          mDirections(scene.desc.render.productSampling && cache.directionLobes && !cache.cells.empty()) {
+          mDirections(scene.desc.render.productSampling && cache.directionLobes && !cache.cells.empty()),
+          mRoulette(scene.desc.render.guidedRoulette && !cache.cells.empty()) {
         mRegionEmits.assign(scene.regions.size(), 0);
         mRegionConstant.assign(scene.regions.size(), 0);
         for (size_t r = 0; r < scene.regions.size(); ++r) {
@@ -41,14 +42,15 @@ public:
     }
 
     bool prepareFlight(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel) const override {
-        // Emission is collected at tracking collisions; unbounded fog has no end.
-        if (mScene.regions[size_t(region)].media.empty() || mRegionEmits[size_t(region)] || !std::isfinite(tEnd))
-            return false;
+        // Emission is collected at tracking collisions.
+        if (mScene.regions[size_t(region)].media.empty() || mRegionEmits[size_t(region)]) return false;
         MarcherScratch& m = scratch(ctx);
         regionIntervals(ctx, region, ray, 0.f, tEnd, ctx.intervals);
         double active = 0;
         for (const Interval& iv : ctx.intervals) active += double(iv.t1) - double(iv.t0);
-        if (!(active > 0)) return false;
+        // A segment to infinity (no surface behind the medium) is guided
+        // through its finite active part; unbounded fog has no end.
+        if (!(active > 0) || !std::isfinite(active)) return false;
         const double dx = std::max(double(mBin), active / MaxFlightBins);
 
         std::vector<PdfStep>& steps = m.pdfSteps;
@@ -104,6 +106,8 @@ public:
         f.region = region;
         f.tEnd = tEnd;
         f.scatter = std::min(-std::expm1(-tau), 1 - MinPass);
+        f.inScattered = m.rayPdf.guidedIntegral();
+        f.transmittance = std::exp(-tau);
         return f.scatter > 0;
     }
 
@@ -140,6 +144,20 @@ public:
         return out;
     }
 
+    FlightEstimate flightEstimate(ThreadContext& ctx) const override {
+        const MarcherScratch::FlightState& f = scratch(ctx).flight;
+        return {f.inScattered, f.transmittance};
+    }
+
+    bool guidesRoulette() const override { return mRoulette; }
+    bool guidesFlights(int region) const override { return mRegionConstant[size_t(region)]; }
+
+    float expectedRadiance(ThreadContext& ctx, const Vec3& x, const Vec3& wo) const override {
+        CacheLookup& cache = scratch(ctx).lookup(mCache);
+        cache.setDirection(wo);
+        return cache.at(x);
+    }
+
     bool prepareDirection(ThreadContext& ctx, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
                           ScatterVertex& vertex) const override {
         if (!mDirections) return false;
@@ -160,6 +178,7 @@ private:
     const RadianceCache& mCache;
     const float mBin;  // the cache's finest cell
     const bool mDirections;
+    const bool mRoulette;
     std::vector<char> mRegionEmits, mRegionConstant;
 };
 

@@ -42,6 +42,7 @@ struct MarcherScratch final : ThreadContextExtension {
         int region = 0;
         float tEnd = 0;
         double scatter = 0;
+        double inScattered = 0, transmittance = 1;  // FlightEstimate
     } flight;
     // The guided marcher's pre-pass (eq. 17's scale): march without sampling
     // and sum each segment's throughput times its histogram integral.

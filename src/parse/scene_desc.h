@@ -107,6 +107,10 @@ struct RenderSettings {
     int raySamples = 4;  // transmittance and guided: L_i samples per ray segment (mean for guided)
     // li = "path" with a directional cache (guided): continuation directions
     // from phase x cached radiance (cache/product_sampler.h), else the phase.
+    // guided_path: Russian roulette and splitting by the cache's radiance
+    // (transport/roulette.h, weightWindow); measured slower at equal time
+    // on fig3b_spots, exp1_sphere and cloud_sun (BENCHMARKS.md).
+    bool guidedRoulette = false;
     bool productSampling = false;  // measured slower to converge on cloud_sun and exp1_sphere (BENCHMARKS.md)
     AovSet aovs;  // none by default: the EXR holds RGBA only
     VolumeSampling volumeSampling = VolumeSampling::Mis;

@@ -311,7 +311,7 @@ AovSet parseAovs(const JsonReader& r) {
 
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
-                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "aovs",
+                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "guided_roulette", "aovs",
                  "volume_sampling", "noise", "denoise"});
     RenderSettings s;
     {
@@ -338,6 +338,7 @@ RenderSettings parseRender(const JsonReader& r) {
     s.globalMajorant = r.choice("majorant", "local", {"local", "global"}) == "global";
     parseLiSource(r.choice("li", liSourceName(s.li), {"path", "photons", "cache"}), s.li);
     s.productSampling = r.boolean("product_sampling", s.productSampling);
+    s.guidedRoulette = r.boolean("guided_roulette", s.guidedRoulette);
     s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
     if (r.has("aovs")) s.aovs = parseAovs(r);
     {

@@ -19,6 +19,14 @@
 
 namespace vdbmarch {
 
+// The guide's estimate of the prepared segment's radiance (from its cache):
+// what scatters towards the ray's origin along it, int sigma_s T L_i dt,
+// and the approximate transmittance to its end.
+struct FlightEstimate {
+    double inScattered = 0;
+    double transmittance = 1;
+};
+
 struct GuidedFlight {
     bool scattered = false;  // false: passed to tEnd
     float t = 0;             // the collision (scattered)
@@ -29,6 +37,9 @@ class PathGuide {
 public:
     virtual ~PathGuide() = default;
 
+    // True when the guide samples the free flights of segments in `region`
+    // (else it prepares them only for flightEstimate).
+    virtual bool guidesFlights(int region) const = 0;
     // Prepares segment [0, tEnd) of `ray` in `region` for the tracked
     // `channel` (< 0: grey). False: leave this segment to delta tracking.
     virtual bool prepareFlight(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel) const = 0;
@@ -38,6 +49,16 @@ public:
     // Draws the prepared segment's free flight; on a collision, mp holds the
     // media there.
     virtual GuidedFlight sampleFlight(ThreadContext& ctx, Rng& rng, MediumPoint& mp) const = 0;
+
+    // The prepared segment's estimate (guided roulette's pixel estimate).
+    virtual FlightEstimate flightEstimate(ThreadContext& ctx) const = 0;
+
+    // True when the guide's radiance may steer Russian roulette and
+    // splitting (render.guided_roulette).
+    virtual bool guidesRoulette() const = 0;
+    // The guide's estimate of the radiance a path at medium point x brings
+    // back along wo (the in-scattered L_i(x, wo), grey); 0 where it has none.
+    virtual float expectedRadiance(ThreadContext& ctx, const Vec3& x, const Vec3& wo) const = 0;
 
     // Prepares the direction sampler at a medium vertex (x, the path arriving
     // along rayDir, media mp there) and points `vertex`'s pathPdf at it, so

@@ -1,5 +1,8 @@
 #include "transport/path_tracer.h"
 
+#include <algorithm>
+#include <array>
+
 #include "core/sampling.h"
 #include "transport/direct_light.h"
 #include "transport/light_distance.h"
@@ -60,8 +63,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
 
         // A guide may take this segment's free flight (path_guide.h); at
         // max_depth a collision could only end the path, so it is tracked.
-        const bool guided =
-            st.guide && st.depth < maxDepth && st.guide->prepareFlight(ctx, region, ray, tEnd, channel);
+        const bool wantEstimate = st.guide && startDepth == 0 && !(st.windowReference > 0) && st.guide->guidesRoulette();
+        const bool prepared = st.guide && (st.depth < maxDepth || wantEstimate) &&
+                              (st.guide->guidesFlights(region) || wantEstimate) &&
+                              st.guide->prepareFlight(ctx, region, ray, tEnd, channel);
+        const bool guided = prepared && st.depth < maxDepth && st.guide->guidesFlights(region);
 
         // Distance sampling towards point, spot and sphere lights along the
         // segment, weighed against the collisions' next-event estimates by
@@ -70,7 +76,27 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             st.depth < maxDepth ? prepareLightDistances(ctx, region, ray, tEnd, channel, st.pointLightsByPhotons)
                                 : LightDistanceSegment{};
         if (guided) lightDistances.guide = st.guide;
+        // The pixel's estimate for guided roulette: what the guide expects
+        // the camera path's first segment through media to bring back.
+        if (prepared && wantEstimate) {
+            const FlightEstimate e = st.guide->flightEstimate(ctx);
+            double I = e.inScattered;
+            if (!hit && light < 0) I += e.transmittance * double(average(scene.environment.radianceSeen(ray.d)));
+            st.windowReference = float(double(average(beta)) * I);
+        }
         if (lightDistances.active) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
+
+        // Copies split from the path at this segment's collision: traced once
+        // the free flight's walk has returned (their own walks reuse its
+        // scratch).
+        struct SplitCopy {
+            Ray ray;
+            Color beta;
+            float pdf = 0;
+        };
+        std::array<SplitCopy, MaxSplitPaths - 1> copies;
+        int numCopies = 0;
+        bool windowed = false;  // roulette was decided by the weight window
 
         // A real scattering event at x (media mp there): next-event
         // estimation, then the next direction (the guide's or the phase's).
@@ -84,16 +110,38 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
             add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, weights)), st.depth);
-            float pdf = 0;
-            const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-            Vec3 wi;
-            if (guidedDirection) {
-                Color w(0);
-                wi = st.guide->sampleDirection(ctx, u0, u1, u2, w, pdf);
-                beta *= pdf > 0 ? w : Color(0);
-            } else {
-                wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
+            // Guided roulette and splitting of what follows the vertex.
+            int paths = 1;
+            if (st.windowReference > 0) {
+                const float r = average(beta) * st.guide->expectedRadiance(ctx, x, -ray.d) / st.windowReference;
+                const WindowDecision d = weightWindow(r, rng.uniform(), st.splitLimit);
+                windowed = true;
+                if (d.paths == 0) {
+                    beta = Color(0);
+                    return false;
+                }
+                beta *= d.weight;
+                paths = d.paths;
+                st.splitLimit = std::max(1, st.splitLimit / paths);
             }
+            // The next direction (the guide's or the phase's), for the path
+            // and for each copy split from it.
+            auto sampleDirection = [&](Color& b, float& pdf) {
+                const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+                if (!guidedDirection) return mp.phase.sample(ray.d, u0, u1, u2, b, pdf);
+                Color w(0);
+                const Vec3 wi = st.guide->sampleDirection(ctx, u0, u1, u2, w, pdf);
+                b *= pdf > 0 ? w : Color(0);
+                return wi;
+            };
+            for (int k = 1; k < paths; ++k) {
+                SplitCopy& c = copies[size_t(numCopies++)];
+                c.beta = beta;
+                c.ray.o = x;
+                c.ray.d = sampleDirection(c.beta, c.pdf);
+            }
+            float pdf = 0;
+            const Vec3 wi = sampleDirection(beta, pdf);
             st.lastPdf = pdf;
             st.specular = false;
             st.lastPoint = x;
@@ -131,9 +179,17 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 return false;
             });
         }
+        for (int k = 0; k < numCopies; ++k) {
+            const SplitCopy& c = copies[size_t(k)];
+            PathState cs = st;
+            cs.lastPdf = c.pdf;
+            const PathRadiance r = tracePath(ctx, c.ray, region, channel, rng, cs);
+            L += c.beta * r.L;
+            direct += c.beta * r.direct;
+        }
         if (isBlack(beta)) return result(0.f);
         if (scattered) {
-            if (!roulette(beta, st.depth, rng)) return result(0.f);
+            if (!windowed && !roulette(beta, st.depth, rng)) return result(0.f);
             continue;
         }
         // Reached tEnd without a real collision.

@@ -11,7 +11,8 @@
 //  - with a guide (path_guide.h), its free flights and directions instead
 //    wherever it takes them;
 //  - phase-mixture sampling, the shared surface event, Russian roulette
-//    after RouletteMinDepth events; max_depth counts scattering events
+//    after RouletteMinDepth events (with a guide that steers roulette, at
+//    every medium vertex by its weight window, splitting too); max_depth counts scattering events
 //    (media and diffuse surfaces).
 // Media whose extinction differs between RGB channels are tracked one
 // channel per path (`channel` >= 0), which keeps every estimator unbiased;
@@ -19,6 +20,7 @@
 #pragma once
 
 #include "core/rng.h"
+#include "transport/roulette.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
@@ -39,6 +41,12 @@ struct PathState {
     // Free flights and medium directions by this guide where it takes them
     // (path_guide.h); null: delta tracking and phase sampling.
     const PathGuide* guide = nullptr;
+    // Guided roulette and splitting (roulette.h, weightWindow): the pixel's
+    // estimate from the guide, set on the camera path's first guided segment
+    // (0: roulette by throughput), and how many paths this one may still
+    // split into.
+    float windowReference = 0;
+    int splitLimit = MaxSplitPaths;
 };
 
 // What a path brings back: a camera path's result (Marcher::radiance) and a

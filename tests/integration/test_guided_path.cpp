@@ -9,11 +9,15 @@
 //    coefficients moved to another cell, or zeroed).
 //  - Whole images against the plain path tracer on the cloud with glass, a
 //    spot, a point and a sphere light and the sky map, with guided
-//    directions off and on (render.product_sampling).
+//    directions off and on (render.product_sampling), and with guided
+//    roulette and splitting (render.guided_roulette), which stay
+//    deterministic for any thread count and crop.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <optional>
 
 #include "illumination/illumination.h"
 #include "marchers/cache_path_guide.h"
@@ -133,15 +137,48 @@ INSTANTIATE_TEST_SUITE_P(Caches, GuidedFlight,
 TEST(GuidedPath, AgreesWithThePathTracerOnAHeterogeneousCloudWithGlassAndSky) {
     std::vector<std::string> common = cloudSkyWithLightsAndGlass();
     common.insert(common.end(), {"render.spp=128", "photons.count=20000"});
-    auto render = [&](const std::string& method, bool product) {
+    auto render = [&](const std::string& method, bool product, bool roulette = false) {
         std::vector<std::string> o = common;
         o.push_back("render.method=\"" + method + "\"");
         o.push_back(str("render.product_sampling=", product ? "true" : "false"));
+        o.push_back(str("render.guided_roulette=", roulette ? "true" : "false"));
         return renderImage(*buildScene(loadSceneFile(samplePath("cloud_sky.json"), o))).image;
     };
     const Image base = render("reference", false);
     for (bool product : {false, true})
         expectPairedAgreement(base, render("guided_path", product), str("product sampling ", product));
+    expectPairedAgreement(base, render("guided_path", false, true), "guided roulette and splitting");
+}
+
+// With guided roulette and splitting (copies traced depth first from the
+// vertex, their random numbers from the path's own stream) the image is the
+// same for any thread count and any crop of the frame.
+TEST(GuidedPath, RouletteAndSplittingAreDeterministicForAnyThreadCountAndCrop) {
+    auto render = [](int threads, bool roulette, std::optional<PixelRect> crop) {
+        RenderOptions options;
+        options.crop = crop;
+        return renderImage(*buildScene(loadSceneFile(
+                               samplePath("cloud.json"),
+                               {"camera.resolution=[32,24]", "render.spp=4", "render.max_depth=8",
+                                "photons.count=20000", "render.method=\"guided_path\"",
+                                str("render.guided_roulette=", roulette ? "true" : "false"),
+                                str("render.threads=", threads)})),
+                           options)
+            .image;
+    };
+    const Image whole = render(1, true, std::nullopt);
+    const Image other = render(3, true, std::nullopt);
+    ASSERT_EQ(whole.rgba.size(), other.rgba.size());
+    EXPECT_EQ(0, std::memcmp(whole.rgba.data(), other.rgba.data(), whole.rgba.size() * sizeof(float)));
+    const PixelRect crop{7, 5, 29, 19};
+    const Image part = render(2, true, crop);
+    for (int y = crop.y0; y < crop.y1; ++y)
+        EXPECT_EQ(0, std::memcmp(&part.rgba[size_t((y - crop.y0) * crop.width()) * 4],
+                                 &whole.rgba[size_t(y * 32 + crop.x0) * 4], size_t(crop.width()) * 4 * sizeof(float)))
+            << "row " << y;
+    // The window did act: without it the pixels differ.
+    const Image plain = render(1, false, std::nullopt);
+    EXPECT_NE(0, std::memcmp(whole.rgba.data(), plain.rgba.data(), whole.rgba.size() * sizeof(float)));
 }
 
 }  // namespace
