@@ -101,7 +101,6 @@ struct RenderSettings {
     int maxSurfaceBounces = 32;
     bool pixelJitter = true;  // false: one ray through each pixel centre
     float exposure = 0;       // PNG preview, stops
-    bool globalMajorant = false;  // reference: one majorant per grid (benchmarks only)
     // How the marchers estimate L_i at their samples.
     LiSource li = LiSource::Path;
     int raySamples = 4;  // transmittance and guided: L_i samples per ray segment (mean for guided)

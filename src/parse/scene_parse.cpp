@@ -335,7 +335,9 @@ RenderSettings parseRender(const JsonReader& r) {
     s.maxSurfaceBounces = r.integer("max_surface_bounces", s.maxSurfaceBounces, 0, 1000);
     s.pixelJitter = r.boolean("pixel_jitter", s.pixelJitter);
     s.exposure = float(r.numberIn("exposure", 0, -64, 64));
-    s.globalMajorant = r.choice("majorant", "local", {"local", "global"}) == "global";
+    // One majorant per VDB block, always: "local" is still accepted (scenes of
+    // 0.3 and before); "global" was a benchmark baseline, removed.
+    r.choice("majorant", "local", {"local"});
     parseLiSource(r.choice("li", liSourceName(s.li), {"path", "photons", "cache"}), s.li);
     s.productSampling = r.boolean("product_sampling", s.productSampling);
     s.guidedRoulette = r.boolean("guided_roulette", s.guidedRoulette);

@@ -10,6 +10,7 @@
 #include "core/sampling.h"
 #include "core/stats.h"
 #include "scene/scene.h"
+#include "transport/majorant_segment.h"
 
 namespace vdbmarch {
 
@@ -22,10 +23,10 @@ struct ThreadContext {
     const Scene& scene;
     std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
     std::vector<Interval> intervals, shadowIntervals, scratch;
-    std::vector<MajorantSegment> majorants;
+    std::vector<MajorantSegment> majorants;  // sigma_maj (tracking.h)
     // Shadow rays' unbiased ray marching (transmittance.cpp): the blocks
     // not sampled yet, and the optical-depth estimates.
-    std::vector<MajorantSegment> shadowMajorants;
+    std::vector<DensityBound> shadowBounds;
     std::vector<double> marchDepths;
     // Distance sampling towards lights along the current path segment
     // (light_distance.h), and next-event weights per light.

@@ -1,7 +1,8 @@
-// Majorants and delta tracking: the free-flight sampler of the reference
-// tracer and the photon tracer. The medium yields (t0, t1, sigma_maj)
-// segments from its VDB tree (one per 8^3 block); the caller's callback
-// handles each tentative collision.
+// Majorants and delta tracking: the free-flight sampler of the path loop and
+// the photon tracer. The medium bounds its density per 8^3 block of its VDB
+// tree (volume/medium.h, DensityBound); times sigma_t that gives the
+// (t0, t1, sigma_maj) segments tracked here; the caller's callback handles
+// each tentative collision.
 #pragma once
 
 #include <algorithm>
@@ -22,19 +23,9 @@ inline float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[cha
 // evalMedia clamps each coefficient to MaxCoefficient, so the extinction
 // never exceeds twice that: the bound keeps huge inputs (density 1e30 x
 // sigma 1e30) finite, where an infinite majorant would stall tracking.
-inline float mediumMajorant(float maxDensity, float sigmaT) {
-    return std::min(maxDensity * sigmaT, 2 * MaxCoefficient);
+inline float mediumMajorant(float densityBound, float sigmaT) {
+    return std::min(densityBound * sigmaT, 2 * MaxCoefficient);
 }
-
-// One medium's majorant segments (of its density) along [0, tEnd): local (per
-// VDB block) by default; with render.global_majorant, the grid's maximum over
-// its bounding box (the classic baseline the local majorants are benchmarked
-// against).
-void mediumMajorants(ThreadContext& ctx, int medium, const Ray& r, float tEnd, std::vector<MajorantSegment>& out);
-// The same segments produced lazily, in increasing t, until visit returns
-// false (a shadow ray ended by roulette stops walking the grid's blocks).
-void forEachMediumMajorant(ThreadContext& ctx, int medium, const Ray& r, float tEnd,
-                           const std::function<bool(const MajorantSegment&)>& visit);
 
 // Combined extinction majorant of the region's media along [0, tEnd) for the
 // tracked `channel`.
@@ -56,7 +47,7 @@ void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int c
     // at that scale whatever the step; ordinary media never reach the rule.
     const double minStep = 1e-6 * double(ctx.scene.step);
     auto track = [&](const MajorantSegment& seg) {
-        const float sigmaMaj = seg.maxDensity;
+        const float sigmaMaj = seg.sigmaMaj;
         if (!(sigmaMaj > 0)) return true;
         const bool absurd = double(sigmaMaj) * double(ctx.scene.step) > 1e6;
         double t = seg.t0;
@@ -68,10 +59,10 @@ void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int c
         }
     };
     const auto& media = ctx.scene.regions[size_t(region)].media;
-    if (media.size() == 1 && !ctx.scene.desc.render.globalMajorant) {
+    if (media.size() == 1) {
         const Medium& m = *ctx.scene.media[size_t(media[0])];
         const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
-        ctx.queries[size_t(media[0])]->forEachMajorant(ray, 0.f, tEnd, [&](const MajorantSegment& s) {
+        ctx.queries[size_t(media[0])]->forEachDensityBound(ray, 0.f, tEnd, [&](const DensityBound& s) {
             return track({s.t0, s.t1, mediumMajorant(s.maxDensity, k)});
         });
     } else if (!media.empty()) {

@@ -68,7 +68,7 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
         // Block by block, lazily: a ray that roulette ends deep in a
         // cloud never visits the blocks behind.
         bool ended = false;
-        forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& seg) {
+        ctx.queries[size_t(mi)]->forEachDensityBound(r, 0.f, tEnd, [&](const DensityBound& seg) {
             // Residual ratio tracking (Novak et al. 2014): the segment's
             // density lower bound is a control whose transmittance is exact,
             // exp(-k rho_min len); tentative collisions only track the
@@ -145,7 +145,7 @@ Color marchedTransmittance(ThreadContext& ctx, int mi, const Ray& r, float tEnd,
     const int n = order + 1;
     auto& depth = ctx.marchDepths;  // per estimate: its residual depth so far
     depth.assign(size_t(2 * n), 0.0);
-    auto& pool = ctx.shadowMajorants;  // segments with residual, not yet sampled
+    auto& pool = ctx.shadowBounds;  // segments with residual, not yet sampled
     pool.clear();
     double poolMass = 0, control = 0;
     // Samples every estimate over the pool: M strata of equal residual mass,
@@ -165,7 +165,7 @@ Color marchedTransmittance(ThreadContext& ctx, int mi, const Ray& r, float tEnd,
                     segStart += (double(pool[seg].maxDensity) - pool[seg].minDensity) * (double(pool[seg].t1) - pool[seg].t0);
                     ++seg;
                 }
-                const MajorantSegment& s = pool[seg];
+                const DensityBound& s = pool[seg];
                 const double lo = s.minDensity, span = double(s.maxDensity) - lo;
                 const double t = std::min(double(s.t1), s.t0 + (c - segStart) / span);
                 ++ctx.counters.shadowSamples;
@@ -190,7 +190,7 @@ Color marchedTransmittance(ThreadContext& ctx, int mi, const Ray& r, float tEnd,
         return true;
     };
     bool ended = false;
-    forEachMediumMajorant(ctx, mi, r, tEnd, [&](const MajorantSegment& s) {
+    ctx.queries[size_t(mi)]->forEachDensityBound(r, 0.f, tEnd, [&](const DensityBound& s) {
         if (!(s.t1 > s.t0)) return true;
         const double len = double(s.t1) - s.t0;
         const float lo = std::max(0.f, std::min(s.minDensity, s.maxDensity));

@@ -19,8 +19,8 @@ public:
         if (mBounds.intersect(r, t0, t1) && t1 > t0) out.push_back({t0, t1});
     }
 
-    void forEachMajorant(const Ray& r, float tMin, float tMax,
-                         const std::function<bool(const MajorantSegment&)>& visit) override {
+    void forEachDensityBound(const Ray& r, float tMin, float tMax,
+                         const std::function<bool(const DensityBound&)>& visit) override {
         float t0 = tMin, t1 = tMax;
         if (!mBounded || (mBounds.intersect(r, t0, t1) && t1 > t0)) visit({t0, t1, 1.f, 1.f});
     }

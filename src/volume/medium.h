@@ -16,10 +16,11 @@
 
 namespace vdbmarch {
 
-// A piece of a ray with an upper bound on the density over it (a local
-// majorant from the VDB tree, for delta and ratio tracking) and a lower bound
-// (the control of residual ratio tracking; 0 where none is known).
-struct MajorantSegment {
+// A piece of a ray with an upper bound on the density over it (per VDB
+// block: times sigma_t it is the local majorant of delta and ratio tracking)
+// and a lower bound (the control of residual ratio tracking; 0 where none is
+// known). Densities, not coefficients.
+struct DensityBound {
     float t0, t1, maxDensity;
     float minDensity = 0;
 };
@@ -45,8 +46,8 @@ public:
     // for VDB grids, constant for homogeneous media), produced lazily: visit
     // is called in increasing t until it returns false (a delta tracker
     // stops at its first real collision without walking the rest of the ray).
-    virtual void forEachMajorant(const Ray& r, float tMin, float tMax,
-                                 const std::function<bool(const MajorantSegment&)>& visit) = 0;
+    virtual void forEachDensityBound(const Ray& r, float tMin, float tMax,
+                                 const std::function<bool(const DensityBound&)>& visit) = 0;
 };
 
 // Picks points of an emissive medium for photon emission. The pdf (per unit

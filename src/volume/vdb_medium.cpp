@@ -262,8 +262,8 @@ public:
     float density(const Vec3& p) override;
     float emission(const Vec3& p) override;
     void activeIntervals(const Ray& r, float tMin, float tMax, std::vector<Interval>& out) override;
-    void forEachMajorant(const Ray& r, float tMin, float tMax,
-                         const std::function<bool(const MajorantSegment&)>& visit) override;
+    void forEachDensityBound(const Ray& r, float tMin, float tMax,
+                         const std::function<bool(const DensityBound&)>& visit) override;
 
 private:
     // Calls visit(t0, t1, block) for each block's tight box along the ray,
@@ -602,13 +602,13 @@ void VdbQuery::activeIntervals(const Ray& r, float tMin, float tMax, std::vector
     });
 }
 
-void VdbQuery::forEachMajorant(const Ray& r, float tMin, float tMax,
-                               const std::function<bool(const MajorantSegment&)>& visit) {
+void VdbQuery::forEachDensityBound(const Ray& r, float tMin, float tMax,
+                               const std::function<bool(const DensityBound&)>& visit) {
     const auto& maxima = mMedium.mBlocks.blockMax;
     const auto& minima = mMedium.mBlocks.blockMin;
     const float scale = mMedium.mScale;
     // Adjacent blocks with the same bounds are merged before visiting.
-    MajorantSegment pending{0, 0, -1};
+    DensityBound pending{0, 0, -1};
     bool stopped = false;
     walkBlocks(r, tMin, tMax, [&](double a, double b, size_t block) {
         float fa = float(a), fb = float(b), m = maxima[block] * scale, lo = minima[block] * scale;

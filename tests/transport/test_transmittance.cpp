@@ -88,14 +88,14 @@ TEST(Transmittance, UnbiasedMarchingMatchesQuadratureAndIsQuieterThanRatioTracki
     EXPECT_LT(sumMarching, 0.5 * sumTracking);
 }
 
-TEST(Transmittance, MajorantSegmentsBoundTheDensityFromBothSides) {
+TEST(Transmittance, DensityBoundsBoundTheDensityFromBothSides) {
     CloudRays c = cloudRays();
     ThreadContext ctx(*c.scene);
     MediumQuery& q = *ctx.queries[0];
     int checked = 0, withControl = 0;
     for (size_t i = 0; i < c.rays.size(); ++i) {
         const Ray& r = c.rays[i];
-        q.forEachMajorant(r, 0.f, c.lengths[i], [&](const MajorantSegment& s) {
+        q.forEachDensityBound(r, 0.f, c.lengths[i], [&](const DensityBound& s) {
             EXPECT_LE(s.minDensity, s.maxDensity);
             withControl += s.minDensity > 0;
             for (int j = 0; j < 64; ++j) {
