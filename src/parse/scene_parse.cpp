@@ -533,11 +533,25 @@ SceneDesc parseSceneJson(const Json& input, const std::string& file, std::option
     return scene;
 }
 
+namespace {
+
+// The keys of a --set assignment's path, "a.b.0.c" -> {a, b, 0, c} (the one
+// place that splits it: applying the override and naming the key it
+// replaced both use it).
+std::vector<std::string> overrideKeys(const std::string& assignment) {
+    std::vector<std::string> parts;
+    std::stringstream ss(assignment.substr(0, assignment.find('=')));
+    for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
+    return parts;
+}
+
+}  // namespace
+
 void applyOverride(Json& doc, const std::string& assignment) {
     size_t eq = assignment.find('=');
     if (eq == std::string::npos || eq == 0)
         throw InputError(str("--set \"", assignment, "\": expected key.path=value"));
-    std::string path = assignment.substr(0, eq), valueText = assignment.substr(eq + 1);
+    const std::string valueText = assignment.substr(eq + 1);
     Json value;
     try {
         value = Json::parse(valueText);
@@ -545,10 +559,7 @@ void applyOverride(Json& doc, const std::string& assignment) {
         value = valueText;  // bare words are strings
     }
     Json* node = &doc;
-    std::stringstream ss(path);
-    std::string part;
-    std::vector<std::string> parts;
-    while (std::getline(ss, part, '.')) parts.push_back(part);
+    const std::vector<std::string> parts = overrideKeys(assignment);
     for (size_t i = 0; i < parts.size(); ++i) {
         const std::string& p = parts[i];
         if (p.empty()) throw InputError(str("--set \"", assignment, "\": empty key in path"));
@@ -599,10 +610,8 @@ SceneDesc parseSceneText(const std::string& text, const std::string& file, const
         // Point at the key in the file, unless an override replaced it (then
         // the bad value is not in the text).
         for (const auto& o : overrides) {
-            std::string path = o.substr(0, o.find('='));
             std::string asKeyPath;
-            std::stringstream ss(path);
-            for (std::string part; std::getline(ss, part, '.');) {
+            for (const std::string& part : overrideKeys(o)) {
                 bool index = !part.empty() && part.find_first_not_of("0123456789") == std::string::npos;
                 asKeyPath += index ? "[" + part + "]" : (asKeyPath.empty() ? "" : ".") + part;
             }
