@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
 #include <exception>
 #include <filesystem>
 #include <memory>
@@ -206,14 +207,14 @@ auto withInputFile(const std::string& path, Fn fn) -> decltype(fn(std::declval<I
 
 void writeExr(const std::string& path, const Image& img, const StringAttributes& attributes,
               const std::vector<ExrLayer>& layers, const std::optional<ExrWindow>& window) {
-    if (img.empty()) throw InputError(str("cannot write '", path, "': image is empty"));
+    if (img.empty()) throw std::logic_error(str(path, ": cannot write: image is empty"));
     if (img.rgba.size() != img.pixelCount() * 4)
-        throw InputError(str("cannot write '", path, "': pixel buffer does not match ", img.width,
+        throw std::logic_error(str(path, ": cannot write: pixel buffer does not match ", img.width,
                              "x", img.height));
     const ExrWindow win = window ? *window : wholeFrame(img);
     if (win.data.width() != img.width || win.data.height() != img.height || win.display.x0 != 0 ||
         win.display.y0 != 0 || !win.display.contains(win.data))
-        throw InputError(str("cannot write '", path, "': data window [", win.data.x0, ", ", win.data.x1, ") x [",
+        throw std::logic_error(str(path, ": cannot write: data window [", win.data.x0, ", ", win.data.x1, ") x [",
                              win.data.y0, ", ", win.data.y1, ") of a ", img.width, "x", img.height,
                              " image does not fit the ", win.display.width(), "x", win.display.height(), " frame"));
     const Imath::Box2i displayWindow(Imath::V2i(0, 0), Imath::V2i(win.display.x1 - 1, win.display.y1 - 1));
@@ -226,7 +227,7 @@ void writeExr(const std::string& path, const Image& img, const StringAttributes&
         // Replacing a standard attribute (e.g. "compression") or a duplicate
         // would silently change the file; refuse instead.
         if (name.empty() || header.find(name) != header.end())
-            throw InputError(str("cannot write '", path, "': duplicate or reserved EXR attribute name '",
+            throw std::logic_error(str(path, ": cannot write: duplicate or reserved EXR attribute name '",
                                  name, "'"));
         header.insert(name, Imf::StringAttribute(value));
     }
@@ -243,12 +244,12 @@ void writeExr(const std::string& path, const Image& img, const StringAttributes&
     for (const ExrLayer& layer : layers) {
         const size_t n = layer.channels.size();
         if (layer.name.empty() || n == 0 || layer.pixels.size() != img.pixelCount() * n)
-            throw InputError(str("cannot write '", path, "': layer '", layer.name, "' does not hold ", n,
+            throw std::logic_error(str(path, ": cannot write: layer '", layer.name, "' does not hold ", n,
                                  " channel(s) of ", img.width, "x", img.height, " pixels"));
         for (size_t c = 0; c < n; ++c) {
             const std::string name = layer.name + "." + layer.channels[c];
             if (header.channels().findChannel(name))
-                throw InputError(str("cannot write '", path, "': duplicate channel '", name, "'"));
+                throw std::logic_error(str(path, ": cannot write: duplicate channel '", name, "'"));
             header.channels().insert(name, Imf::Channel(Imf::FLOAT));
             float* layerBase = const_cast<float*>(layer.pixels.data()) + c;
             fb.insert(name, Imf::Slice::Make(Imf::FLOAT, layerBase, dataWindow, n * sizeof(float),
@@ -263,7 +264,7 @@ void writeExr(const std::string& path, const Image& img, const StringAttributes&
         out.setFrameBuffer(fb);
         out.writePixels(img.height);
     } catch (const std::exception& e) {
-        throw IoError(str("cannot write '", path, "': ", e.what()));
+        throw IoError(str(path, ": cannot write: ", e.what()));
     }
     file.commit();
 }

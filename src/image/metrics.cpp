@@ -120,9 +120,7 @@ RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, fl
 }
 
 double lowFrequencyError(const Image& test, const Image& reference, int block) {
-    if (test.width != reference.width || test.height != reference.height)
-        throw InputError(str("images differ in size: ", test.width, "x", test.height, " against ", reference.width, "x",
-                             reference.height));
+    checkSameSize(test, reference);
     double se = 0, refSum = 0;
     size_t blocks = 0, pixels = 0;
     for (int by = 0; by < reference.height; by += block)

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
 
 namespace vdbmarch {
 
@@ -25,13 +26,13 @@ float srgbToLinear(float v) {
 
 void writePngRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
     if (width <= 0 || height <= 0)
-        throw InputError(str("cannot write '", path, "': image is empty (", width, "x", height, ")"));
+        throw std::logic_error(str(path, ": cannot write: image is empty (", width, "x", height, ")"));
     if (rgb.size() != size_t(width) * size_t(height) * 3)
-        throw InputError(str("cannot write '", path, "': pixel buffer does not match ", width, "x", height));
+        throw std::logic_error(str(path, ": cannot write: pixel buffer does not match ", width, "x", height));
 
     AtomicFile file(path);
     std::FILE* f = std::fopen(file.tempPath().c_str(), "wb");
-    if (!f) throw IoError(str("cannot write '", path, "': ", std::strerror(errno)));
+    if (!f) throw IoError(str(path, ": cannot write: ", std::strerror(errno)));
 
     png_image image;
     std::memset(&image, 0, sizeof(image));
@@ -47,17 +48,17 @@ void writePngRgb8(const std::string& path, int width, int height, const std::vec
     errno = 0;
     bool closed = std::fclose(f) == 0;
     int closeErr = errno;
-    if (!ok) throw IoError(str("cannot write '", path, "': ", pngMessage));
+    if (!ok) throw IoError(str(path, ": cannot write: ", pngMessage));
     if (streamFailed || !closed)
-        throw IoError(str("cannot write '", path, "': ", std::strerror(closeErr ? closeErr : EIO)));
+        throw IoError(str(path, ": cannot write: ", std::strerror(closeErr ? closeErr : EIO)));
     file.commit();
 }
 
 void writePng(const std::string& path, const Image& img, float exposureStops) {
     if (!std::isfinite(exposureStops))
-        throw InputError(str("cannot write '", path, "': exposure ", exposureStops, " is not finite"));
+        throw std::logic_error(str(path, ": cannot write: exposure ", exposureStops, " is not finite"));
     if (img.rgba.size() != img.pixelCount() * 4)
-        throw InputError(str("cannot write '", path, "': pixel buffer does not match ", img.width,
+        throw std::logic_error(str(path, ": cannot write: pixel buffer does not match ", img.width,
                              "x", img.height));
     writePngRgb8(path, img.width, img.height, toSrgb8(img, exposureStops));
 }
