@@ -53,10 +53,11 @@ std::vector<NeighbourReach> neighbourReaches() {
 // Origins of the 8^3 blocks of the grid's active topology dilated by one voxel
 // in all 26 directions (a point is non-empty iff its floor voxel is active
 // there), sorted x-major; `bounds` gets the dilated active voxels' box. As
-// OpenVDB's dilateActiveValues with IGNORE_TILES on a topology copy: every
+// OpenVDB's dilateActiveValues by one voxel on a topology copy: every
 // leaf, the neighbours its active voxels reach, and the blocks of active
-// tiles (tiles are not dilated); done on the leaves' masks, in a tree with one
-// voxel per block, without building the dilated tree.
+// tiles with the layer of blocks below their low faces (where their trilinear
+// support reaches); done on the leaves' masks, in a tree with one voxel per
+// block, without building the dilated tree.
 std::deque<Coord> dilatedBlockOrigins(const openvdb::FloatTree& tree, openvdb::CoordBBox& bounds) {
     static const std::vector<NeighbourReach> reaches = neighbourReaches();
     openvdb::BoolTree blocks(false);
@@ -77,15 +78,20 @@ std::deque<Coord> dilatedBlockOrigins(const openvdb::FloatTree& tree, openvdb::C
             if (!hit.isOff()) acc.setValueOn(b + n.step);
         }
     }
-    // Active tiles: the interior nodes' values only (the leaves' voxels are done).
+    // Active tiles: the interior nodes' values only (the leaves' voxels are
+    // done). A tile's trilinear support reaches one voxel past each face: on
+    // the high side that lies in the tile's own last blocks (a block holds
+    // o + [0, 8]), on the low side in the blocks below it, which are added.
     auto tile = tree.cbeginValueOn();
     tile.setMaxDepth(openvdb::FloatTree::DEPTH - 2);
     for (; tile; ++tile) {
-        const openvdb::CoordBBox box = tile.getBoundingBox();
+        openvdb::CoordBBox box = tile.getBoundingBox();
+        box.expand(1);
         bounds.expand(box);
-        for (int x = box.min().x(); x <= box.max().x(); x += 8)
-            for (int y = box.min().y(); y <= box.max().y(); y += 8)
-                for (int z = box.min().z(); z <= box.max().z(); z += 8) acc.setValueOn(Coord(x, y, z) >> 3);
+        const Coord lo = box.min() >> 3, hi = tile.getBoundingBox().max() >> 3;
+        for (int x = lo.x(); x <= hi.x(); ++x)
+            for (int y = lo.y(); y <= hi.y(); ++y)
+                for (int z = lo.z(); z <= hi.z(); ++z) acc.setValueOn(Coord(x, y, z));
     }
     std::deque<Coord> origins;
     for (auto it = blocks.cbeginValueOn(); it; ++it) {
