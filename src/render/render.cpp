@@ -21,7 +21,9 @@ namespace vdbmarch {
 
 namespace {
 
-constexpr int TileSize = 16;
+// Threads take the image in work blocks of WorkBlockSize^2 pixels (not the
+// farm's tiles, app/tiles.h, nor the noise target's blocks below).
+constexpr int WorkBlockSize = 16;
 
 class ProgressBar {
 public:
@@ -283,8 +285,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                     str("--passes ", a, "-", b, ": the sums of ", b - a, " passes of ", ww, "x", wh, " pixels"));
     }
 
-    const int tilesX = (ww + TileSize - 1) / TileSize, tilesY = (wh + TileSize - 1) / TileSize;
-    const int tiles = tilesX * tilesY;
+    const int workBlocksX = (ww + WorkBlockSize - 1) / WorkBlockSize, workBlocksY = (wh + WorkBlockSize - 1) / WorkBlockSize;
+    const int workBlocks = workBlocksX * workBlocksY;
     RenderResult result;
     result.window = window;
     result.totalPhotonPasses = totalPhotonPasses;
@@ -296,8 +298,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // Adaptive sampling towards the noise target (render.noise).
     const bool adaptive = rs.noise > 0;
     if (adaptive) sums.convergedAt.assign(pixels, 0);
-    std::vector<RenderCounters> tileCounters(static_cast<size_t>(tiles));
-    ProgressBar progress(options.progress, timed || options.checkpoint || rs.noise > 0 ? 1000 : tiles);
+    std::vector<RenderCounters> workBlockCounters(static_cast<size_t>(workBlocks));
+    ProgressBar progress(options.progress, timed || options.checkpoint || rs.noise > 0 ? 1000 : workBlocks);
     const int threads = resolveThreadCount(rs.threads);
     result.threads = threads;
     auto start = std::chrono::steady_clock::now();
@@ -344,12 +346,12 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // count, never on how samples were split into passes or threads.
     auto renderPass = [&](int s0, int s1) {
         arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
-                for (int tile = range.begin(); tile != range.end(); ++tile) {
+            tbb::parallel_for(tbb::blocked_range<int>(0, workBlocks, 1), [&](const tbb::blocked_range<int>& range) {
+                for (int workBlock = range.begin(); workBlock != range.end(); ++workBlock) {
                     ThreadContext ctx(scene);
-                    const int x0 = window.x0 + (tile % tilesX) * TileSize, y0 = window.y0 + (tile / tilesX) * TileSize;
-                    for (int y = y0; y < std::min(y0 + TileSize, window.y1); ++y)
-                        for (int x = x0; x < std::min(x0 + TileSize, window.x1); ++x) {
+                    const int x0 = window.x0 + (workBlock % workBlocksX) * WorkBlockSize, y0 = window.y0 + (workBlock / workBlocksX) * WorkBlockSize;
+                    for (int y = y0; y < std::min(y0 + WorkBlockSize, window.y1); ++y)
+                        for (int x = x0; x < std::min(x0 + WorkBlockSize, window.x1); ++x) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
                             if (adaptive && sums.convergedAt[local] > 0) continue;  // met the noise target
@@ -389,7 +391,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                                 }
                             }
                         }
-                    tileCounters[size_t(tile)] += ctx.counters;
+                    workBlockCounters[size_t(workBlock)] += ctx.counters;
                     if (!timed && !hooks && !adaptive) progress.tick();
                 }
             }, tbb::simple_partitioner());
@@ -440,7 +442,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // The counters so far, those of a resumed render's first runs included.
     auto counters = [&] {
         RenderCounters total = resumedCounters;
-        for (const auto& t : tileCounters) total += t;
+        for (const auto& t : workBlockCounters) total += t;
         return total;
     };
 

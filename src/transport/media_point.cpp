@@ -62,7 +62,7 @@ void regionIntervals(ThreadContext& ctx, int region, const Ray& r, float tMin, f
         ctx.queries[size_t(media[0])]->activeIntervals(r, tMin, tMax, out);
         return;
     }
-    auto& all = ctx.scratch;
+    auto& all = ctx.mediaIntervals;
     all.clear();
     for (int mi : media) ctx.queries[size_t(mi)]->activeIntervals(r, tMin, tMax, all);
     std::sort(all.begin(), all.end(), [](const Interval& a, const Interval& b) { return a.t0 < b.t0; });

@@ -87,8 +87,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         if (lightDistances.active) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
 
         // Copies split from the path at this segment's collision: traced once
-        // the free flight's walk has returned (their own walks reuse its
-        // scratch).
+        // the free flight's walk has returned (their own walks reuse the
+        // thread context's majorants and the guide's prepared segment).
         struct SplitCopy {
             Ray ray;
             Color beta;

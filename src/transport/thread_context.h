@@ -22,7 +22,8 @@ struct ThreadContext {
     explicit ThreadContext(const Scene& s);
     const Scene& scene;
     std::vector<std::unique_ptr<MediumQuery>> queries;  // one per medium
-    std::vector<Interval> intervals, shadowIntervals, scratch;
+    std::vector<Interval> intervals, shadowIntervals;
+    std::vector<Interval> mediaIntervals;  // every medium's intervals before regionIntervals merges them
     std::vector<MajorantSegment> majorants;  // sigma_maj (tracking.h)
     // Shadow rays' unbiased ray marching (transmittance.cpp): the blocks
     // not sampled yet, and the optical-depth estimates.

@@ -1,7 +1,7 @@
 // Participating media: a homogeneous box (or all space) and VDB density grids.
 // The interface hides OpenVDB so that only src/volume/*.cpp include its heavy
 // headers. Per-thread state (VDB accessors, DDA scratch) lives in a
-// MediumQuery made once per tile.
+// MediumQuery made once per work block of a render.
 #pragma once
 
 #include <cstdint>
