@@ -168,7 +168,25 @@ Image downscaleBox(const Image& img, int width, int height) {
     return out;
 }
 
-BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
+namespace {
+
+// What a bench compares: vdb_render (budgets are march steps in voxels) or
+// one of vdbmarch's methods (budgets are samples or seconds).
+struct BenchMethod {
+    std::string name;
+    bool vdbRender = false;
+    Method method = Method::Reference;
+    const std::vector<double>& budgets(const BenchOptions& o) const { return vdbRender ? o.vdbRenderSteps : o.budgets; }
+};
+
+// The strip's columns (the reference's, then the longest budget list) and
+// its gaps in pixels.
+struct StripLayout {
+    int columns = 0, gaps = 0;
+};
+
+// Refuses bad options before anything renders; the methods by name.
+std::vector<BenchMethod> checkOptions(const BenchOptions& o, StripLayout& strip) {
     if (o.methods.empty()) throw InputError("bench: --methods is empty");
     if (o.budgets.empty()) throw InputError("bench: --budgets is empty");
     for (double b : o.vdbRenderSteps)
@@ -176,150 +194,111 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     for (double b : o.budgets)
         if (!(b > 0) || (!o.budgetSeconds && b != std::floor(b)))
             throw InputError(str("bench: budget ", b, " must be a positive ", o.budgetSeconds ? "number of seconds" : "whole number of samples"));
-    // Strip columns: the longest budget list of the methods (vdb_render has its own).
-    int stripColumns = o.stripReference ? 1 : 0;
-    {
-        size_t most = 0;
-        for (const auto& m : o.methods)
-            most = std::max(most, (m == "vdb_render" ? o.vdbRenderSteps : o.budgets).size());
-        stripColumns += int(most);
+    std::vector<BenchMethod> methods;
+    for (const std::string& name : o.methods) {
+        BenchMethod m{name, name == "vdb_render"};
+        if (!m.vdbRender && !parseMethod(name, m.method))
+            throw InputError(str("bench: unknown method \"", name, "\" (", methodList(), " or vdb_render)"));
+        methods.push_back(m);
     }
-    const int stripGaps =
-        (stripColumns - 1) * StripSeparator + (o.stripReference ? StripReferenceGap - StripSeparator : 0);
-    if (!o.stripPath.empty() && o.stripMaxWidth < stripColumns + stripGaps)
-        throw InputError(str("bench: --strip-width ", o.stripMaxWidth, " is too small for ", stripColumns,
-                             " strip columns (at least ", stripColumns + stripGaps, " pixels)"));
-    ::mkdir(o.outDir.c_str(), 0755);
-    checkWritable(o.outDir + "/bench.csv");
-    if (!o.stripPath.empty()) checkWritable(o.stripPath);
-    BenchResult result;
-    // Loaded once: every render below only changes the render settings.
-    std::unique_ptr<Scene> scene = buildScene(baseScene);
-    auto renderWith = [&](const std::string& method, int spp, uint64_t seed, const RenderOptions& ro) {
-        if (!parseMethod(method, scene->desc.render.method)) throw InputError(str("bench: unknown method \"", method, "\""));
-        scene->desc.render.spp = spp;
-        scene->desc.render.seed = seed;
-        return renderImage(*scene, ro);
-    };
+    size_t most = 0;
+    for (const BenchMethod& m : methods) most = std::max(most, m.budgets(o).size());
+    strip.columns = (o.stripReference ? 1 : 0) + int(most);
+    strip.gaps = (strip.columns - 1) * StripSeparator + (o.stripReference ? StripReferenceGap - StripSeparator : 0);
+    if (!o.stripPath.empty() && o.stripMaxWidth < strip.columns + strip.gaps)
+        throw InputError(str("bench: --strip-width ", o.stripMaxWidth, " is too small for ", strip.columns,
+                             " strip columns (at least ", strip.columns + strip.gaps, " pixels)"));
+    return methods;
+}
 
-    // Reference: given, or the reference method at a high spp, cached by a
-    // hash of the effective scene and spp. Rendered as two independent halves
-    // so its own noise can be estimated: Var(mean) = Var(A - B) / 4.
-    Image reference;
+// Renders `scene` with `method` at `spp` and `seed` (only the render
+// settings change between the bench's renders: the media load once).
+RenderResult renderWith(Scene& scene, Method method, int spp, uint64_t seed, const RenderOptions& ro) {
+    scene.desc.render.method = method;
+    scene.desc.render.spp = spp;
+    scene.desc.render.seed = seed;
+    return renderImage(scene, ro);
+}
+
+// The reference: given, or the reference method at a high spp, cached in
+// outDir by a hash of the effective scene and spp. Rendered as two
+// independent halves so its own noise can be estimated: Var(mean) =
+// Var(A - B) / 4.
+Image benchReference(Scene& scene, const SceneDesc& baseScene, const BenchOptions& o, BenchResult& result) {
     if (!o.referencePath.empty()) {
-        reference = readExr(o.referencePath);
         result.referenceImage = o.referencePath;
-    } else {
-        uint64_t h = hashValues(fnv1a64(baseScene.jsonText), uint64_t(o.referenceSpp));
-        char name[64];
-        std::snprintf(name, sizeof(name), "reference_%016llx.exr", static_cast<unsigned long long>(h));
-        std::string path = o.outDir + "/" + name, halfPath = path + ".half.exr";
-        if (fileExists(path) && fileExists(halfPath)) {
-            reference = readExr(path);
-            Image a = readExr(halfPath);
-            result.referenceNoiseRmse = compareImages(a, reference).rmse;  // |A - mean| = |A - B| / 2
-            result.referenceNoiseLowFreq = lowFrequencyError(a, reference);
-        } else {
-            std::fprintf(stderr, "bench: rendering the reference (%d spp, method reference)...\n", o.referenceSpp);
-            Image halves[2];
-            for (int i = 0; i < 2; ++i)
-                halves[i] = renderWith("reference", std::max(1, o.referenceSpp / 2), 1000003u + uint64_t(i), {}).image;
-            reference = Image(halves[0].width, halves[0].height);
-            for (size_t i = 0; i < reference.rgba.size(); ++i)
-                reference.rgba[i] = 0.5f * (halves[0].rgba[i] + halves[1].rgba[i]);
-            result.referenceNoiseRmse = compareImages(halves[0], reference).rmse;
-            result.referenceNoiseLowFreq = lowFrequencyError(halves[0], reference);
-            writeExr(path, reference, {{"vdbmarch:method", "reference"}, {"vdbmarch:spp", std::to_string(o.referenceSpp)}});
-            writeExr(halfPath, halves[0], {{"vdbmarch:method", "reference"}});
-        }
-        result.referenceImage = path;
+        return readExr(o.referencePath);
     }
+    const uint64_t h = hashValues(fnv1a64(baseScene.jsonText), uint64_t(o.referenceSpp));
+    char name[64];
+    std::snprintf(name, sizeof(name), "reference_%016llx.exr", static_cast<unsigned long long>(h));
+    const std::string path = o.outDir + "/" + name, halfPath = path + ".half.exr";
+    result.referenceImage = path;
+    Image reference;
+    if (fileExists(path) && fileExists(halfPath)) {
+        reference = readExr(path);
+        Image a = readExr(halfPath);
+        result.referenceNoiseRmse = compareImages(a, reference).rmse;  // |A - mean| = |A - B| / 2
+        result.referenceNoiseLowFreq = lowFrequencyError(a, reference);
+        return reference;
+    }
+    std::fprintf(stderr, "bench: rendering the reference (%d spp, method reference)...\n", o.referenceSpp);
+    Image halves[2];
+    for (int i = 0; i < 2; ++i)
+        halves[i] = renderWith(scene, Method::Reference, std::max(1, o.referenceSpp / 2), 1000003u + uint64_t(i), {}).image;
+    reference = Image(halves[0].width, halves[0].height);
+    for (size_t i = 0; i < reference.rgba.size(); ++i) reference.rgba[i] = 0.5f * (halves[0].rgba[i] + halves[1].rgba[i]);
+    result.referenceNoiseRmse = compareImages(halves[0], reference).rmse;
+    result.referenceNoiseLowFreq = lowFrequencyError(halves[0], reference);
+    writeExr(path, reference, {{"vdbmarch:method", "reference"}, {"vdbmarch:spp", std::to_string(o.referenceSpp)}});
+    writeExr(halfPath, halves[0], {{"vdbmarch:method", "reference"}});
+    return reference;
+}
 
-    // Tiles keep the image size unless the strip would exceed its width.
-    int tileW = reference.width, tileH = reference.height;
-    if (tileW * stripColumns + stripGaps > o.stripMaxWidth) {
-        tileW = std::max(1, (o.stripMaxWidth - stripGaps) / stripColumns);
-        tileH = std::max(1, int(std::lround(double(reference.height) * tileW / reference.width)));
+// One vdb_render run per repeat; budget = step in voxels; time = the whole
+// command (load + render + write). vdb_render is deterministic: the last
+// run's file is the median run's image.
+Image runVdbRender(const SceneDesc& baseScene, const Scene& scene, const BenchOptions& o, double step, double& seconds) {
+    const std::string out = o.outDir + str("/vdb_render_step", step, ".exr");
+    const std::string cmd = vdbRenderCommand(baseScene, scene, step, out);
+    std::vector<double> times;
+    for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
+        auto t0 = std::chrono::steady_clock::now();
+        if (std::system(cmd.c_str()) != 0)
+            throw IoError(str("bench: vdb_render failed (is libopenvdb-tools installed?): ", cmd));
+        times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    // Downscaled as soon as rendered, so large benches do not hold every image.
-    auto makeTile = [&](const Image& img) {
-        return tileW == img.width && tileH == img.height ? img : downscaleBox(img, tileW, tileH);
-    };
-    std::vector<std::vector<Image>> tiles(o.methods.size());
-    if (!o.stripPath.empty() && o.stripReference) {
-        Image referenceTile = makeTile(reference);
-        for (auto& row : tiles) row.push_back(referenceTile);
-    }
-    auto measure = [&](BenchRow& row, const Image& img) {
-        RelErrorSpread sp = relativeErrorSpread(img, reference, BenchSpreadMinAlpha);
-        row.relP50 = sp.p50;
-        row.relP95 = sp.p95;
-        row.relSpread = sp.ratio;
-        row.lowFreq = lowFrequencyError(img, reference);
-        result.spreadEps = sp.eps;
-        result.spreadPixels = sp.pixels;
-    };
+    seconds = times[medianRun(times)];
+    return readExr(out);
+}
 
-    for (size_t mi = 0; mi < o.methods.size(); ++mi) {
-        const std::string& method = o.methods[mi];
-        for (double budget : method == "vdb_render" ? o.vdbRenderSteps : o.budgets) {
-            if (method == "vdb_render") {
-                // Budget = step in voxels; time = the whole command (load + render + write).
-                std::string out = o.outDir + str("/vdb_render_step", budget, ".exr");
-                std::string cmd = vdbRenderCommand(baseScene, *scene, budget, out);
-                std::vector<double> times;
-                for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
-                    auto t0 = std::chrono::steady_clock::now();
-                    if (std::system(cmd.c_str()) != 0)
-                        throw IoError(str("bench: vdb_render failed (is libopenvdb-tools installed?): ", cmd));
-                    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-                }
-                // vdb_render is deterministic: the last run's file is the median run's image.
-                Image img = readExr(out);
-                ImageErrorStats e = compareImages(img, reference);
-                BenchRow row{method, budget, times[medianRun(times)], e.rmse, e.relMse, 1};
-                measure(row, img);
-                if (!o.stripPath.empty()) tiles[mi].push_back(makeTile(img));
-                std::fprintf(stderr, "bench: %-10s step %-8g %9.3f s  rmse %.5g  relmse %.5g  rel p95/p50 %.4g\n",
-                             method.c_str(), budget, row.seconds, row.rmse, row.relMse, row.relSpread);
-                result.rows.push_back(row);
-                continue;
-            }
-            RenderOptions ro;
-            if (o.budgetSeconds) ro.timeBudget = budget;
-            const int spp = o.budgetSeconds ? baseScene.render.spp : int(budget);
-            // All runs are kept until the median-time one is known: with
-            // --seconds their sample counts, hence images, may differ.
-            std::vector<double> times;
-            std::vector<RenderResult> runs;
-            for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
-                runs.push_back(renderWith(method, spp, baseScene.render.seed, ro));
-                times.push_back(runs.back().seconds);
-            }
-            const RenderResult& med = runs[medianRun(times)];
-            ImageErrorStats e = compareImages(med.image, reference);
-            BenchRow row{method, budget, med.seconds, e.rmse, e.relMse, med.spp};
-            measure(row, med.image);
-            if (!o.stripPath.empty()) tiles[mi].push_back(makeTile(med.image));
-            std::fprintf(stderr, "bench: %-10s budget %-8g %4d spp %9.3f s  rmse %.5g  relmse %.5g  LF %.4g  rel p95/p50 %.4g\n",
-                         method.c_str(), budget, row.spp, row.seconds, row.rmse, row.relMse, row.lowFreq, row.relSpread);
-            result.rows.push_back(row);
-        }
-    }
+// The error of `img` against the reference: RMSE, relMSE, the relative
+// error's spread and the low-frequency error.
+BenchRow measureRow(const std::string& method, double budget, double seconds, int spp, const Image& img,
+                    const Image& reference, BenchResult& result) {
+    const ImageErrorStats e = compareImages(img, reference);
+    BenchRow row{method, budget, seconds, e.rmse, e.relMse, spp};
+    const RelErrorSpread sp = relativeErrorSpread(img, reference, BenchSpreadMinAlpha);
+    row.relP50 = sp.p50;
+    row.relP95 = sp.p95;
+    row.relSpread = sp.ratio;
+    row.lowFreq = lowFrequencyError(img, reference);
+    result.spreadEps = sp.eps;
+    result.spreadPixels = sp.pixels;
+    return row;
+}
 
-    // CSV
+std::string benchCsv(const std::vector<BenchRow>& rows) {
     std::ostringstream csv;
     csv << "method,budget,spp,seconds,rmse,relmse,rel_p50,rel_p95,rel_p95_over_p50,low_freq\n";
-    for (const auto& r : result.rows)
+    for (const auto& r : rows)
         csv << r.method << "," << r.budget << "," << r.spp << "," << r.seconds << "," << r.rmse << "," << r.relMse
             << "," << r.relP50 << "," << r.relP95 << "," << r.relSpread << "," << r.lowFreq << "\n";
-    result.csvPath = o.outDir + "/bench.csv";
-    writeTextFileAtomic(result.csvPath, csv.str());
+    return csv.str();
+}
 
-    // Markdown: the measurements, then ratios between methods from power-law
-    // fits error = c * time^b (log-log least squares per method), evaluated at
-    // the geometric mean of all measured times.
-    std::ostringstream md;
+// The measurements as a Markdown table, with what its columns mean.
+void writeMeasurements(std::ostringstream& md, const BenchResult& result) {
     md << "# vdbmarch bench\n\nReference image: `" << result.referenceImage << "`";
     if (result.referenceNoiseRmse > 0)
         md << " (its own estimated noise: RMSE " << result.referenceNoiseRmse << ", LF error "
@@ -336,6 +315,12 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
        << " pixels where the reference's alpha >= " << BenchSpreadMinAlpha
        << " (medium or surface in view); p50 and p95 are its nearest-rank percentiles. p95/p50 measures how unevenly "
           "the error is spread over the image: lower is more homogeneous.\n";
+}
+
+// Ratios between methods from power-law fits error = c * time^b (log-log
+// least squares per method), evaluated at the geometric mean of all
+// measured times.
+void writeRatios(std::ostringstream& md, const BenchResult& result, const std::vector<std::string>& methods) {
     double logSum = 0;
     int count = 0;
     for (const auto& r : result.rows)
@@ -343,9 +328,9 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
             logSum += std::log(r.seconds);
             ++count;
         }
-    double tMid = count ? std::exp(logSum / count) : 1;
+    const double tMid = count ? std::exp(logSum / count) : 1;
     std::vector<PowerFit> fits;
-    for (const auto& m : o.methods) {
+    for (const auto& m : methods) {
         std::vector<BenchRow> mine;
         for (const auto& r : result.rows)
             if (r.method == m) mine.push_back(r);
@@ -353,21 +338,21 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     }
     md << "\nFits RMSE = c * seconds^b and ratios at " << tMid << " s (row method / column method):\n\n";
     md << "| method | b | RMSE at " << tMid << " s |";
-    for (const auto& m : o.methods) md << " equal-time error ratio vs " << m << " | equal-error time ratio vs " << m << " |";
+    for (const auto& m : methods) md << " equal-time error ratio vs " << m << " | equal-error time ratio vs " << m << " |";
     md << "\n|---|---|---|";
-    for (size_t i = 0; i < o.methods.size(); ++i) md << "---|---|";
+    for (size_t i = 0; i < methods.size(); ++i) md << "---|---|";
     md << "\n";
-    for (size_t i = 0; i < o.methods.size(); ++i) {
-        md << "| " << o.methods[i] << " | ";
+    for (size_t i = 0; i < methods.size(); ++i) {
+        md << "| " << methods[i] << " | ";
         if (!fits[i].ok) {
             md << "n/a | n/a |";
-            for (size_t j = 0; j < o.methods.size(); ++j) md << " n/a | n/a |";
+            for (size_t j = 0; j < methods.size(); ++j) md << " n/a | n/a |";
             md << "\n";
             continue;
         }
-        double ei = fits[i].at(tMid);
+        const double ei = fits[i].at(tMid);
         md << fits[i].b << " | " << ei << " |";
-        for (size_t j = 0; j < o.methods.size(); ++j) {
+        for (size_t j = 0; j < methods.size(); ++j) {
             if (!fits[j].ok) {
                 md << " n/a | n/a |";
                 continue;
@@ -376,17 +361,20 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
         }
         md << "\n";
     }
-    // Convergence: the slopes of log error against log time, and the error at
-    // the largest budget over the error at the budget closest to a quarter of
-    // it (1/2 for noise falling as 1/sqrt(time); near 1: a plateau). The
-    // reference's own noise is taken out in quadrature first, so that a
-    // method does not look stuck at the floor of an imperfect truth.
+}
+
+// Convergence: the slopes of log error against log time, and the error at
+// the largest budget over the error at the budget closest to a quarter of
+// it (1/2 for noise falling as 1/sqrt(time); near 1: a plateau). The
+// reference's own noise is taken out in quadrature first, so that a method
+// does not look stuck at the floor of an imperfect truth.
+void writeConvergence(std::ostringstream& md, const BenchResult& result, const std::vector<std::string>& methods) {
     auto net = [](double e, double noise) { return std::sqrt(std::max(0.0, e * e - noise * noise)); };
     md << "\nConvergence per method: slopes b of RMSE and LF error against time (-0.5 for unbiased noise; near 0: "
           "a plateau), and error at the last budget over error at a quarter of it, both net of the reference's own "
           "noise (subtracted in quadrature):\n\n"
           "| method | b (RMSE) | b (LF) | RMSE ratio | LF ratio | |\n|---|---|---|---|---|---|\n";
-    for (const auto& m : o.methods) {
+    for (const auto& m : methods) {
         std::vector<BenchRow> mine;
         for (const auto& r : result.rows)
             if (r.method == m) {
@@ -405,11 +393,96 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
         md << "| " << m << " | " << (fr.ok ? str(fr.b) : "n/a") << " | " << (fl.ok ? str(fl.b) : "n/a") << " | " << rr
            << " | " << lr << " | " << (rr > 0.6 || lr > 0.6 ? "**plateau** (ratio > 0.6)" : "converging") << " |\n";
     }
+}
+
+// Plots with gnuplot when it is installed (tools/plot_bench.gp); the path
+// written, or empty.
+std::string plotBench(const std::string& csvPath, const std::string& plotPath) {
+    const std::string script = std::string(VDBMARCH_DATA_DIR) + "/tools/plot_bench.gp";
+    const std::string cmd = "command -v gnuplot >/dev/null 2>&1 && gnuplot -e \"csv='" + csvPath + "'; out='" +
+                            plotPath + ".tmp.png'\" '" + script + "' && mv '" + plotPath + ".tmp.png' '" + plotPath + "'";
+    if (std::system(cmd.c_str()) == 0) return plotPath;
+    warn(str("bench: no plot written (gnuplot missing or failed; Debian package gnuplot-nox)"));
+    return "";
+}
+
+}  // namespace
+
+BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
+    StripLayout strip;
+    const std::vector<BenchMethod> methods = checkOptions(o, strip);
+    ::mkdir(o.outDir.c_str(), 0755);
+    checkWritable(o.outDir + "/bench.csv");
+    if (!o.stripPath.empty()) checkWritable(o.stripPath);
+    BenchResult result;
+    std::unique_ptr<Scene> scene = buildScene(baseScene);  // loaded once
+    const Image reference = benchReference(*scene, baseScene, o, result);
+
+    // Strip tiles keep the image size unless the strip would exceed its
+    // width; downscaled as soon as rendered, so large benches do not hold
+    // every image.
+    int tileW = reference.width, tileH = reference.height;
+    if (tileW * strip.columns + strip.gaps > o.stripMaxWidth) {
+        tileW = std::max(1, (o.stripMaxWidth - strip.gaps) / strip.columns);
+        tileH = std::max(1, int(std::lround(double(reference.height) * tileW / reference.width)));
+    }
+    auto makeTile = [&](const Image& img) {
+        return tileW == img.width && tileH == img.height ? img : downscaleBox(img, tileW, tileH);
+    };
+    std::vector<std::vector<Image>> tiles(methods.size());
+    if (!o.stripPath.empty() && o.stripReference) {
+        const Image referenceTile = makeTile(reference);
+        for (auto& row : tiles) row.push_back(referenceTile);
+    }
+
+    // ---- The runs: each method at each budget, the median-time run measured.
+    for (size_t mi = 0; mi < methods.size(); ++mi) {
+        const BenchMethod& method = methods[mi];
+        for (double budget : method.budgets(o)) {
+            BenchRow row;
+            if (method.vdbRender) {
+                double seconds = 0;
+                const Image img = runVdbRender(baseScene, *scene, o, budget, seconds);
+                row = measureRow(method.name, budget, seconds, 1, img, reference, result);
+                if (!o.stripPath.empty()) tiles[mi].push_back(makeTile(img));
+                std::fprintf(stderr, "bench: %-10s step %-8g %9.3f s  rmse %.5g  relmse %.5g  rel p95/p50 %.4g\n",
+                             method.name.c_str(), budget, row.seconds, row.rmse, row.relMse, row.relSpread);
+            } else {
+                RenderOptions ro;
+                if (o.budgetSeconds) ro.timeBudget = budget;
+                const int spp = o.budgetSeconds ? baseScene.render.spp : int(budget);
+                // All runs are kept until the median-time one is known: with
+                // --seconds their sample counts, hence images, may differ.
+                std::vector<double> times;
+                std::vector<RenderResult> runs;
+                for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
+                    runs.push_back(renderWith(*scene, method.method, spp, baseScene.render.seed, ro));
+                    times.push_back(runs.back().seconds);
+                }
+                const RenderResult& med = runs[medianRun(times)];
+                row = measureRow(method.name, budget, med.seconds, med.spp, med.image, reference, result);
+                if (!o.stripPath.empty()) tiles[mi].push_back(makeTile(med.image));
+                std::fprintf(stderr,
+                             "bench: %-10s budget %-8g %4d spp %9.3f s  rmse %.5g  relmse %.5g  LF %.4g  rel p95/p50 %.4g\n",
+                             method.name.c_str(), budget, row.spp, row.seconds, row.rmse, row.relMse, row.lowFreq,
+                             row.relSpread);
+            }
+            result.rows.push_back(row);
+        }
+    }
+
+    // ---- The outputs: CSV, the Markdown table, the strip, the plot.
+    result.csvPath = o.outDir + "/bench.csv";
+    writeTextFileAtomic(result.csvPath, benchCsv(result.rows));
+    std::ostringstream md;
+    writeMeasurements(md, result);
+    writeRatios(md, result, o.methods);
+    writeConvergence(md, result, o.methods);
     if (!o.stripPath.empty()) {
-        writeStrip(o.stripPath, tiles, stripColumns, o.stripReference, tileW, tileH, baseScene.render.exposure);
+        writeStrip(o.stripPath, tiles, strip.columns, o.stripReference, tileW, tileH, baseScene.render.exposure);
         result.stripPath = o.stripPath;
         result.stripRows = int(tiles.size());
-        result.stripColumns = stripColumns;
+        result.stripColumns = strip.columns;
         result.tileWidth = tileW;
         result.tileHeight = tileH;
         std::string names;
@@ -420,17 +493,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
     }
     result.tablePath = o.outDir + "/bench.md";
     writeTextFileAtomic(result.tablePath, md.str());
-
-    // Plot with gnuplot when it is installed (tools/plot_bench.gp).
-    result.plotPath = o.outDir + "/bench.png";
-    std::string script = std::string(VDBMARCH_DATA_DIR) + "/tools/plot_bench.gp";
-    std::string cmd = "command -v gnuplot >/dev/null 2>&1 && gnuplot -e \"csv='" + result.csvPath + "'; out='" +
-                      result.plotPath + ".tmp.png'\" '" + script + "' && mv '" + result.plotPath + ".tmp.png' '" +
-                      result.plotPath + "'";
-    if (std::system(cmd.c_str()) != 0) {
-        warn(str("bench: no plot written (gnuplot missing or failed; Debian package gnuplot-nox)"));
-        result.plotPath.clear();
-    }
+    result.plotPath = plotBench(result.csvPath, o.outDir + "/bench.png");
     return result;
 }
 

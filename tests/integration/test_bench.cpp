@@ -55,6 +55,17 @@ TEST(Bench, WritesCsvAndTableAndReusesItsReference) {
     EXPECT_DOUBLE_EQ(b.rows[0].rmse, a.rows[0].rmse);
 }
 
+// A method name the bench does not know is refused before anything renders
+// or is written (it used to fail only after the reference was rendered).
+TEST(Bench, UnknownMethodIsRefusedBeforeAnyRender) {
+    TempDir dir;
+    BenchOptions o = uniformAndReference(dir / "bench");
+    o.methods = {"uniform", "guidd"};
+    expectErrorContaining<InputError>([&] { runBench(smallCloud(), o); },
+                                      {"unknown method \"guidd\"", "reference", "vdb_render"});
+    EXPECT_TRUE(listDir(dir.path()).empty());
+}
+
 // vdb_render as a benchmarked method: runs with the scene translated to its
 // options, and refuses scenes it cannot express, naming why.
 TEST(Bench, VdbRenderIsAMethodForScenesItCanExpress) {
