@@ -258,52 +258,45 @@ std::string valueRange(const std::vector<Tile>& tiles, const std::string& name) 
     return lo == hi ? str(lo) : str(lo, "-", hi);
 }
 
-}  // namespace
-
-MergedTiles mergeTiles(const std::vector<std::string>& paths) {
-    if (paths.empty()) throw InputError("merge: no tiles given");
-    std::vector<Tile> tiles;
-    tiles.reserve(paths.size());
-    for (const std::string& path : paths) {
-        Tile t;
-        t.path = path;
-        t.contents = readExrContents(path);
-        for (const auto& [k, v] : t.contents.attributes) t.attributes[k] = v;
-        if (!t.attributes.count(TileSplitAttribute) || !t.attributes.count(TileAttribute))
-            throw InputError(str(path, ": not a vdbmarch tile (no ", TileSplitAttribute,
-                                 " attribute): render tiles with --tile I/N or --crop"));
-        const std::string& split = t.attribute(TileSplitAttribute);
-        const size_t space = split.find(' ');
-        if (space != std::string::npos && split.substr(space) == " passes") {
-            char extra = 0;
-            const int total = std::atoi(split.c_str());
-            if (std::sscanf(t.attribute(TileAttribute).c_str(), "%d-%d%c", &t.firstPass, &t.endPass, &extra) != 2 ||
-                split != str(total, " passes") || total < 1 || t.firstPass < 0 || t.endPass <= t.firstPass)
-                throw InputError(str(path, ": damaged part header: ", TileSplitAttribute, " = \"", split, "\", ",
-                                     TileAttribute, " = \"", t.attribute(TileAttribute), "\""));
-            for (const std::string& item : splitList(t.attribute(PassSamplesAttribute))) {
-                int p = 0, k = 0;
-                if (std::sscanf(item.c_str(), "%d:%d%c", &p, &k, &extra) != 2)
-                    throw InputError(str(path, ": damaged part header: ", PassSamplesAttribute, " = \"",
-                                         t.attribute(PassSamplesAttribute), "\""));
-                t.samples.emplace_back(p, k);
-            }
-        } else if (split != "crop") {
-            char extra = 0;
-            if (std::sscanf(t.attribute(TileAttribute).c_str(), "%d/%d%c", &t.index, &t.count, &extra) != 2 ||
-                split != str(t.count, " bands") || t.index < 0 || t.index >= t.count)
-                throw InputError(str(path, ": damaged tile header: ", TileSplitAttribute, " = \"", split, "\", ",
-                                     TileAttribute, " = \"", t.attribute(TileAttribute), "\""));
+// A tile's file and its header: which band, crop or passes it holds.
+Tile readTile(const std::string& path) {
+    Tile t;
+    t.path = path;
+    t.contents = readExrContents(path);
+    for (const auto& [k, v] : t.contents.attributes) t.attributes[k] = v;
+    if (!t.attributes.count(TileSplitAttribute) || !t.attributes.count(TileAttribute))
+        throw InputError(str(path, ": not a vdbmarch tile (no ", TileSplitAttribute,
+                             " attribute): render tiles with --tile I/N or --crop"));
+    const std::string& split = t.attribute(TileSplitAttribute);
+    const size_t space = split.find(' ');
+    if (space != std::string::npos && split.substr(space) == " passes") {
+        char extra = 0;
+        const int total = std::atoi(split.c_str());
+        if (std::sscanf(t.attribute(TileAttribute).c_str(), "%d-%d%c", &t.firstPass, &t.endPass, &extra) != 2 ||
+            split != str(total, " passes") || total < 1 || t.firstPass < 0 || t.endPass <= t.firstPass)
+            throw InputError(str(path, ": damaged part header: ", TileSplitAttribute, " = \"", split, "\", ",
+                                 TileAttribute, " = \"", t.attribute(TileAttribute), "\""));
+        for (const std::string& item : splitList(t.attribute(PassSamplesAttribute))) {
+            int p = 0, k = 0;
+            if (std::sscanf(item.c_str(), "%d:%d%c", &p, &k, &extra) != 2)
+                throw InputError(str(path, ": damaged part header: ", PassSamplesAttribute, " = \"",
+                                     t.attribute(PassSamplesAttribute), "\""));
+            t.samples.emplace_back(p, k);
         }
-        tiles.push_back(std::move(t));
+    } else if (split != "crop") {
+        char extra = 0;
+        if (std::sscanf(t.attribute(TileAttribute).c_str(), "%d/%d%c", &t.index, &t.count, &extra) != 2 ||
+            split != str(t.count, " bands") || t.index < 0 || t.index >= t.count)
+            throw InputError(str(path, ": damaged tile header: ", TileSplitAttribute, " = \"", split, "\", ",
+                                 TileAttribute, " = \"", t.attribute(TileAttribute), "\""));
     }
+    return t;
+}
 
-    // Every tile against the first: the same split, frame, scene and
-    // settings (any vdbmarch:* attribute but the per-tile ones).
+// Every tile against the first: the same split, frame, scene and settings
+// (any vdbmarch:* attribute but the per-tile ones), and the same AOV layers.
+void checkSameRender(const std::vector<Tile>& tiles, bool timed) {
     const Tile& ref = tiles.front();
-    // A time budget or a noise target: tiles render as many samples as they need.
-    const bool timed = ref.attribute("vdbmarch:timeBudget") != "none" ||
-                       (ref.attributes.count(NoiseTargetAttribute) && ref.attribute(NoiseTargetAttribute) != "none");
     // The split and frame first, the named settings next, the hash of the
     // rest of the scene last, so the message names the most telling one.
     std::vector<std::string> keys = {TileSplitAttribute, "vdbmarch:frame"};
@@ -336,9 +329,12 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
         if (!sameLayers)
             throw InputError(str(t.path, ": belongs to another render than ", ref.path, ": its AOV layers differ"));
     }
+}
 
-    if (ref.firstPass >= 0) return mergePasses(tiles);
-    const PixelRect frame = ref.contents.window.display;
+// The bands or crops lie inside the frame where their headers say, and
+// cover it exactly once: duplicates, overlaps and holes are named.
+void checkCoverage(const std::vector<Tile>& tiles, const PixelRect& frame) {
+    const Tile& ref = tiles.front();
     for (const Tile& t : tiles) {
         const PixelRect& d = t.contents.window.data;
         if (frame.x0 != 0 || frame.y0 != 0 || !frame.contains(d))
@@ -383,8 +379,13 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
                              frame.width(), "x", frame.height(), " frame; the first hole is at pixel (",
                              hole % size_t(frame.width()), ", ", hole / size_t(frame.width()), "); nothing written"));
     }
+}
 
-    // Assemble: RGBA and every layer, row by row.
+// The frame from its bands or crops: RGBA and every layer, row by row; the
+// header's noise and sample counts combined over the tiles.
+MergedTiles assembleFrame(const std::vector<Tile>& tiles, const PixelRect& frame, bool timed) {
+    const Tile& ref = tiles.front();
+    const uint64_t framePixels = uint64_t(frame.width()) * uint64_t(frame.height());
     size_t floatsPerPixel = 4;
     for (const ExrLayer& l : ref.contents.layers) floatsPerPixel += l.channels.size();
     checkMemory(framePixels * floatsPerPixel * sizeof(float), str("the merged ", frame.width(), "x", frame.height(), " frame"));
@@ -428,6 +429,24 @@ MergedTiles mergeTiles(const std::vector<std::string>& paths) {
         out.warnings.push_back(str("the tiles were rendered with a time budget or a noise target and reached ", valueRange(tiles, "vdbmarch:spp"),
                                    " samples per pixel: noise (and, with photons, bias) may differ between tiles"));
     return out;
+}
+
+}  // namespace
+
+MergedTiles mergeTiles(const std::vector<std::string>& paths) {
+    if (paths.empty()) throw InputError("merge: no tiles given");
+    std::vector<Tile> tiles;
+    tiles.reserve(paths.size());
+    for (const std::string& path : paths) tiles.push_back(readTile(path));
+    const Tile& ref = tiles.front();
+    // A time budget or a noise target: tiles render as many samples as they need.
+    const bool timed = ref.attribute("vdbmarch:timeBudget") != "none" ||
+                       (ref.attributes.count(NoiseTargetAttribute) && ref.attribute(NoiseTargetAttribute) != "none");
+    checkSameRender(tiles, timed);
+    if (ref.firstPass >= 0) return mergePasses(tiles);
+    const PixelRect frame = ref.contents.window.display;
+    checkCoverage(tiles, frame);
+    return assembleFrame(tiles, frame, timed);
 }
 
 }  // namespace vdbmarch
