@@ -201,6 +201,124 @@ struct NoiseTotals {
     }
 };
 
+// The noise target (render.noise, docs/noise.md) at a check after n samples:
+// the two halves give every pixel's variance; true once the window's RMSE is
+// below noise x its mean. Until then each 8x8 block of pixels gets samples in
+// proportion to its per-sample standard deviation s_b, the allocation that
+// minimises the image's MSE for a sample count (n_b = k s_b gives MSE =
+// mean(s_b) / k), with k set so that this MSE meets the target: a block
+// stops (sums.convergedAt) once n >= k s_b. The decisions depend only on the
+// sums, so the image is the same for any thread count.
+bool noiseTargetStep(PixelSums& sums, const PassSums& open, float noise, int ww, int wh, int n) {
+    const size_t pixels = size_t(ww) * size_t(wh);
+    std::vector<float> perSample(pixels);  // variance of one sample, RGB summed
+    NoiseTotals totals;
+    for (size_t p = 0; p < pixels; ++p) {
+        Color L = sums.L[p], odd = sums.oddL[p], mean, var;
+        if (open.pass >= 0) {
+            L += open.L[p].rounded();
+            odd += open.oddL[p].rounded();
+        }
+        const int k = sums.convergedAt[p] > 0 ? sums.convergedAt[p] : n;
+        if (!pixelNoise(L, odd, 0, k, mean, var)) return false;
+        perSample[p] = float((double(var.x) + double(var.y) + double(var.z)) * k);
+        totals.add(mean, var);
+    }
+    const NoiseEstimate image = totals.estimate();
+    const double target = double(noise) * image.mean;
+    if (image.rmse <= target) return true;
+    // s_b per block, and k from their pixel-weighted mean.
+    const int bx = (ww + NoiseBlock - 1) / NoiseBlock, by = (wh + NoiseBlock - 1) / NoiseBlock;
+    std::vector<double> sigma(size_t(bx) * size_t(by), 0.0);
+    std::vector<int> count(sigma.size(), 0);
+    for (int y = 0; y < wh; ++y)
+        for (int x = 0; x < ww; ++x) {
+            const size_t b = size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock);
+            sigma[b] += perSample[size_t(y) * size_t(ww) + size_t(x)];
+            ++count[b];
+        }
+    double weighted = 0;
+    for (size_t b = 0; b < sigma.size(); ++b) {
+        sigma[b] = std::sqrt(sigma[b] / (3.0 * count[b]));
+        weighted += sigma[b] * count[b];
+    }
+    const double k = weighted / double(pixels) / (target * target);
+    for (int y = 0; y < wh; ++y)
+        for (int x = 0; x < ww; ++x) {
+            int& c = sums.convergedAt[size_t(y) * size_t(ww) + size_t(x)];
+            if (c == 0 && double(n) >= k * sigma[size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock)]) c = n;
+        }
+    return false;
+}
+
+// The samples [first, last) of the photon passes `passes` = [a, b) asked for
+// (render --passes), refused where a render cannot be split by passes.
+std::pair<int, int> samplesOfPasses(const Scene& scene, const PhotonPasses& photonPasses, std::pair<int, int> passes,
+                                    bool timed, int totalPasses, int ww, int wh) {
+    const RenderSettings& rs = scene.desc.render;
+    const AovSet& aovs = rs.aovs;
+    const size_t pixels = size_t(ww) * size_t(wh);
+    const auto [a, b] = passes;
+    if (timed) throw InputError("--passes and --time: a part of a render by passes renders fixed samples");
+    if (rs.noise > 0)
+        throw InputError(str("--passes and render.noise = ", rs.noise, ": a part of a render by passes renders "
+                             "fixed samples; split a render to a noise target by tiles instead"));
+    if (aovs.any())
+        throw InputError(str("--passes ", a, "-", b, " and render.aovs: AOVs are not split by passes; split the "
+                             "render by tiles instead"));
+    if (!photonPasses.progressive())
+        throw InputError(str("--passes ", a, "-", b, ": this render has no progressive photon passes (method ",
+                             methodName(rs.method), "): split it by tiles instead"));
+    if (a < 0 || b <= a || b > totalPasses)
+        throw InputError(str("--passes ", a, "-", b, ": this render has passes 0 to ", totalPasses - 1, " (",
+                             rs.spp, " spp, ", photonPasses.samplesPerPass(), " per pass); the range is FIRST-END "
+                             "with END excluded, at most ", totalPasses));
+    // Each pass's sums are kept until written (one EXR layer per pass).
+    checkMemory(uint64_t(b - a) * uint64_t(pixels) * (sizeof(ColorSum) + sizeof(double) + 4 * sizeof(float)),
+                str("--passes ", a, "-", b, ": the sums of ", b - a, " passes of ", ww, "x", wh, " pixels"));
+    return {photonPasses.firstSampleOf(a), std::min(rs.spp, photonPasses.firstSampleOf(b))};
+}
+
+// Camera sample s of pixel (x, y) (`pixel` its index in the frame, `local`
+// in the window's buffers): its radiance into the open pass's sums and its
+// odd half, and with AOVs the direct part and the first event's features. A
+// non-finite sample is dropped and counted, never written.
+void addCameraSample(const Scene& scene, const Marcher& marcher, ThreadContext& ctx, int x, int y, uint64_t pixel,
+                     int s, size_t local, PassSums& open, AovSums& aovSums) {
+    const RenderSettings& rs = scene.desc.render;
+    const AovSet& aovs = rs.aovs;
+    Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
+    float jx = 0.5f, jy = 0.5f;
+    if (rs.pixelJitter) {
+        jx = rng.uniform();
+        jy = rng.uniform();
+    }
+    const Ray ray = scene.camera->generateRay(float(x) + jx, float(y) + jy);
+    const PathRadiance pr = marcher.radiance(ray, rng, ctx);
+    if (!isFinite(pr.L) || !std::isfinite(pr.transmittance)) {
+        ++ctx.counters.nonFiniteSamples;
+        return;
+    }
+    open.L[local].add(pr.L);
+    open.T[local] += pr.transmittance;
+    if (s & 1) {
+        open.oddL[local].add(pr.L);
+        open.oddT[local] += pr.transmittance;
+    }
+    if (!aovs.any()) return;
+    if (aovs.splitDirect()) aovSums.direct[local] += pr.direct;
+    if (aovs.firstEvent()) {
+        Rng aovRng(hashValues(rs.seed, pixel, AovStream), uint64_t(s));
+        const FirstEvent fe = traceFirstEvent(ctx, ray, aovRng);
+        if (aovs.depth && fe.hasDepth) {
+            aovSums.depth[local] += double(scene.camera->viewDepth(fe.depthPoint));
+            ++aovSums.depthSamples[local];
+        }
+        if (aovs.albedo) aovSums.albedo[local] += fe.albedo;
+        if (aovs.normal) aovSums.normal[local] += fe.normal;
+    }
+}
+
 }  // namespace
 
 Image PixelSums::evenHalf(int width, int height) const { return halfImage(*this, width, height, false); }
@@ -262,28 +380,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const int totalPasses = photonPasses.passOf(std::max(0, rs.spp - 1)) + 1;
     const int totalPhotonPasses = timed ? 0 : totalPasses;
     int first = 0, last = rs.spp;
-    if (options.passes) {
-        const auto [a, b] = *options.passes;
-        if (timed) throw InputError("--passes and --time: a part of a render by passes renders fixed samples");
-        if (rs.noise > 0)
-            throw InputError(str("--passes and render.noise = ", rs.noise, ": a part of a render by passes renders "
-                                 "fixed samples; split a render to a noise target by tiles instead"));
-        if (aovs.any())
-            throw InputError(str("--passes ", a, "-", b, " and render.aovs: AOVs are not split by passes; split the "
-                                 "render by tiles instead"));
-        if (!photonPasses.progressive())
-            throw InputError(str("--passes ", a, "-", b, ": this render has no progressive photon passes (method ",
-                                 methodName(rs.method), "): split it by tiles instead"));
-        if (a < 0 || b <= a || b > totalPasses)
-            throw InputError(str("--passes ", a, "-", b, ": this render has passes 0 to ", totalPasses - 1, " (",
-                                 rs.spp, " spp, ", photonPasses.samplesPerPass(), " per pass); the range is FIRST-END "
-                                 "with END excluded, at most ", totalPasses));
-        first = photonPasses.firstSampleOf(a);
-        last = std::min(rs.spp, photonPasses.firstSampleOf(b));
-        // Each pass's sums are kept until written (one EXR layer per pass).
-        checkMemory(uint64_t(b - a) * uint64_t(pixels) * (sizeof(ColorSum) + sizeof(double) + 4 * sizeof(float)),
-                    str("--passes ", a, "-", b, ": the sums of ", b - a, " passes of ", ww, "x", wh, " pixels"));
-    }
+    if (options.passes)
+        std::tie(first, last) = samplesOfPasses(scene, photonPasses, *options.passes, timed, totalPasses, ww, wh);
 
     const int workBlocksX = (ww + WorkBlockSize - 1) / WorkBlockSize, workBlocksY = (wh + WorkBlockSize - 1) / WorkBlockSize;
     const int workBlocks = workBlocksX * workBlocksY;
@@ -355,41 +453,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
                             if (adaptive && sums.convergedAt[local] > 0) continue;  // met the noise target
-                            ColorSum& sum = open.L[local];
-                            double& transmittance = open.T[local];
-                            for (int s = s0; s < s1; ++s) {
-                                Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
-                                float jx = 0.5f, jy = 0.5f;
-                                if (rs.pixelJitter) {
-                                    jx = rng.uniform();
-                                    jy = rng.uniform();
-                                }
-                                Ray ray = scene.camera->generateRay(float(x) + jx, float(y) + jy);
-                                PathRadiance pr = marcher->radiance(ray, rng, ctx);
-                                if (!isFinite(pr.L) || !std::isfinite(pr.transmittance)) {
-                                    ++ctx.counters.nonFiniteSamples;  // dropped, never written
-                                    continue;
-                                }
-                                sum.add(pr.L);
-                                transmittance += pr.transmittance;
-                                if (s & 1) {
-                                    open.oddL[local].add(pr.L);
-                                    open.oddT[local] += pr.transmittance;
-                                }
-                                if (aovs.any()) {
-                                    if (aovs.splitDirect()) aovSums.direct[local] += pr.direct;
-                                    if (aovs.firstEvent()) {
-                                        Rng aovRng(hashValues(rs.seed, pixel, AovStream), uint64_t(s));
-                                        const FirstEvent fe = traceFirstEvent(ctx, ray, aovRng);
-                                        if (aovs.depth && fe.hasDepth) {
-                                            aovSums.depth[local] += double(scene.camera->viewDepth(fe.depthPoint));
-                                            ++aovSums.depthSamples[local];
-                                        }
-                                        if (aovs.albedo) aovSums.albedo[local] += fe.albedo;
-                                        if (aovs.normal) aovSums.normal[local] += fe.normal;
-                                    }
-                                }
-                            }
+                            for (int s = s0; s < s1; ++s)
+                                addCameraSample(scene, *marcher, ctx, x, y, pixel, s, local, open, aovSums);
                         }
                     workBlockCounters[size_t(workBlock)] += ctx.counters;
                     if (!timed && !hooks && !adaptive) progress.tick();
@@ -482,56 +547,11 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         return stop;
     };
 
-    // The noise target (render.noise, docs/noise.md): at fixed sample
-    // counts (isNoiseCheck) the two halves give every pixel's variance; the
-    // render stops once the window's RMSE is below noise x its mean. Until
-    // then each 8x8 block of pixels gets samples in proportion to its
-    // per-sample standard deviation s_b, the allocation that minimises the
-    // image's MSE for a sample count (n_b = k s_b gives MSE = mean(s_b) / k),
-    // with k set so that this MSE meets the target: a block stops once
-    // n >= k s_b. The decisions depend only on the sums, so the image is the
-    // same for any thread count.
+    // The noise target (render.noise): checked at fixed sample counts.
     bool reachedTarget = false;
     auto checkNoise = [&](int n) {
         if (!adaptive || !isNoiseCheck(n)) return false;
-        std::vector<float> perSample(pixels);  // variance of one sample, RGB summed
-        NoiseTotals totals;
-        for (size_t p = 0; p < pixels; ++p) {
-            Color L = sums.L[p], odd = sums.oddL[p], mean, var;
-            if (open.pass >= 0) {
-                L += open.L[p].rounded();
-                odd += open.oddL[p].rounded();
-            }
-            const int k = sums.convergedAt[p] > 0 ? sums.convergedAt[p] : n;
-            if (!pixelNoise(L, odd, 0, k, mean, var)) return false;
-            perSample[p] = float((double(var.x) + double(var.y) + double(var.z)) * k);
-            totals.add(mean, var);
-        }
-        const NoiseEstimate image = totals.estimate();
-        const double target = double(rs.noise) * image.mean;
-        if (image.rmse <= target) return reachedTarget = true;
-        // s_b per block, and k from their pixel-weighted mean.
-        const int bx = (ww + NoiseBlock - 1) / NoiseBlock, by = (wh + NoiseBlock - 1) / NoiseBlock;
-        std::vector<double> sigma(size_t(bx) * size_t(by), 0.0);
-        std::vector<int> count(sigma.size(), 0);
-        for (int y = 0; y < wh; ++y)
-            for (int x = 0; x < ww; ++x) {
-                const size_t b = size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock);
-                sigma[b] += perSample[size_t(y) * size_t(ww) + size_t(x)];
-                ++count[b];
-            }
-        double weighted = 0;
-        for (size_t b = 0; b < sigma.size(); ++b) {
-            sigma[b] = std::sqrt(sigma[b] / (3.0 * count[b]));
-            weighted += sigma[b] * count[b];
-        }
-        const double k = weighted / double(pixels) / (target * target);
-        for (int y = 0; y < wh; ++y)
-            for (int x = 0; x < ww; ++x) {
-                int& c = sums.convergedAt[size_t(y) * size_t(ww) + size_t(x)];
-                if (c == 0 && double(n) >= k * sigma[size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock)]) c = n;
-            }
-        return false;
+        return reachedTarget = noiseTargetStep(sums, open, rs.noise, ww, wh, n);
     };
 
     int spp = resumeSample - first;
