@@ -54,6 +54,15 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     auto result = [&](float transmittance) { return PathRadiance{L, transmittance, direct}; };
     int surfaceBounces = 0;
     MediumPoint mp;
+    // Copies split from the path at a segment's collision: traced once the
+    // free flight's walk has returned (their own walks reuse the thread
+    // context's majorants and the guide's prepared segment).
+    struct SplitCopy {
+        Ray ray;
+        Color beta;
+        float pdf = 0;
+    };
+    std::array<SplitCopy, MaxSplitPaths - 1> copies;
     while (true) {
         const RaySegment seg = nextRaySegment(scene, ray);
         const SurfaceHit& h = seg.surface;
@@ -63,11 +72,12 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
 
         // A guide may take this segment's free flight (path_guide.h); at
         // max_depth a collision could only end the path, so it is tracked.
+        // Guided roulette's pixel estimate needs the camera path's first
+        // segment prepared even where flights stay with delta tracking.
         const bool wantEstimate = st.guide && startDepth == 0 && !(st.windowReference > 0) && st.guide->guidesRoulette();
-        const bool prepared = st.guide && (st.depth < maxDepth || wantEstimate) &&
-                              (st.guide->guidesFlights(region) || wantEstimate) &&
-                              st.guide->prepareFlight(ctx, region, ray, tEnd, channel);
-        const bool guided = prepared && st.depth < maxDepth && st.guide->guidesFlights(region);
+        const bool flights = st.guide && st.depth < maxDepth && st.guide->guidesFlights(region);
+        const bool prepared = (flights || wantEstimate) && st.guide->prepareFlight(ctx, region, ray, tEnd, channel);
+        const bool guided = prepared && flights;
 
         // Distance sampling towards point, spot and sphere lights along the
         // segment, weighed against the collisions' next-event estimates by
@@ -86,16 +96,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         }
         if (lightDistances.active) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
 
-        // Copies split from the path at this segment's collision: traced once
-        // the free flight's walk has returned (their own walks reuse the
-        // thread context's majorants and the guide's prepared segment).
-        struct SplitCopy {
-            Ray ray;
-            Color beta;
-            float pdf = 0;
-        };
-        std::array<SplitCopy, MaxSplitPaths - 1> copies;
-        int numCopies = 0;
+        int numCopies = 0;  // of `copies`, split at this segment's collision
         bool windowed = false;  // roulette was decided by the weight window
 
         // A real scattering event at x (media mp there): next-event
