@@ -20,8 +20,8 @@
 #include "illumination/illumination.h"
 #include "transport/media_point.h"
 #include "transport/roulette.h"
-#include "marchers/marcher.h"
-#include "marchers/segment_marcher.h"
+#include "estimators/estimator.h"
+#include "estimators/segment_marcher.h"
 #include "scene/scene.h"
 #include "parse/scene_desc.h"
 #include "volume/medium.h"
@@ -416,12 +416,12 @@ void marchSampleBench(benchmark::State& state, const std::string& method, const 
                       bool absorbing = false) {
     MarchBench& b = marchBench(li, raySamples, absorbing);
     // Photons, cache and (guided) the eq. 17 pre-pass, once per process.
-    static std::map<std::string, std::unique_ptr<Marcher>> marchers;
+    static std::map<std::string, std::unique_ptr<Estimator>> marchers;
     auto& marcher = marchers[method + "/" + li + "/" + std::to_string(raySamples) + (absorbing ? "/absorbing" : "")];
     if (!marcher) {
         Method m = Method::Uniform;
         parseMethod(method, m);
-        marcher = makeMarcher(m, *b.scene, std::make_shared<Illumination>(prepareIllumination(*b.scene, m)));
+        marcher = makeEstimator(m, *b.scene, std::make_shared<Illumination>(prepareIllumination(*b.scene, m)));
     }
     ThreadContext ctx(*b.scene);
     for (auto _ : state) {

@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
     render->add_option("--png", ra.png, "Also write an sRGB PNG preview");
     addSceneOptions(render, ra, renderSceneOptions());
     render->add_option("--time", ra.timeBudget,
-                       "Time budget in seconds for the whole run, instead of --spp: whole passes of one sample "
+                       "Time budget in seconds for the whole run, instead of --spp: whole sweeps of one sample "
                        "per pixel while the next fits");
     render->add_flag("--denoise", ra.denoise,
                      "Denoise the EXR's RGBA too, keeping the noisy beauty as layer 'noisy' (render.denoise = on; "
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
     bench->add_option("--budgets", ba.budgets, "Comma-separated budgets: spp, or seconds with --seconds");
     bench->add_option("--vdb-render-steps", ba.vdbSteps,
                       "Steps in voxels for the method vdb_render (OpenVDB's renderer; default 4,2,1,0.5)");
-    bench->add_flag("--seconds", ba.options.budgetSeconds, "Budgets are seconds (whole passes within the time)");
+    bench->add_flag("--seconds", ba.options.budgetSeconds, "Budgets are seconds (whole sweeps of one sample per pixel within the time)");
     bench->add_option("--reference", ba.options.referencePath, "Reference EXR (default: render one with the reference method)");
     bench->add_option("--reference-spp", ba.options.referenceSpp, "Samples per pixel of a rendered reference (default 256)");
     bench->add_option("--repeats", ba.options.repeats, "Runs per point; the median time is kept (default 1)");

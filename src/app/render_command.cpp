@@ -221,7 +221,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         options.runStart = t0;
     }
     if (tile.count > 0 || tile.cropped) options.crop = window;
-    if (tile.byPasses()) options.passes = std::make_pair(tile.firstPass, tile.endPass);
+    if (tile.byPasses()) options.photonPassRange = std::make_pair(tile.firstPass, tile.endPass);
     // The denoiser (docs/denoise.md) works on the two half renders: of the
     // whole frame here, of a tile's after merge (a tile alone would show seams).
     const RenderSettings::Denoise denoiseMode = desc.render.denoise;

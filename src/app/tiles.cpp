@@ -60,7 +60,7 @@ PixelRect windowOf(const TileRequest& r, int width, int height) {
 StringAttributes tileAttributes(const TileRequest& r, const RenderResult& result) {
     if (r.byPasses()) {
         std::string samples;
-        for (const PassSums& p : result.passSums) samples += str(samples.empty() ? "" : ",", p.pass, ":", p.samples);
+        for (const PhotonPassSums& p : result.passSums) samples += str(samples.empty() ? "" : ",", p.pass, ":", p.samples);
         return {{TileSplitAttribute, str(result.totalPhotonPasses, " passes")},
                 {TileAttribute, str(r.firstPass, "-", r.endPass)},
                 {PassSamplesAttribute, samples}};
@@ -84,7 +84,7 @@ StringAttributes noiseAttributes(const NoiseEstimate& e) {
 std::vector<ExrLayer> passLayers(const RenderResult& result) {
     std::vector<ExrLayer> layers;
     // Each pass's sums, and those of its odd-index samples (the noise estimate).
-    for (const PassSums& p : result.passSums)
+    for (const PhotonPassSums& p : result.passSums)
         for (const bool odd : {false, true}) {
             ExrLayer l{str("pass", p.pass, odd ? "odd" : ""), {"R", "G", "B", "T"}, {}};
             l.pixels.reserve(p.L.size() * 4);
@@ -205,7 +205,7 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
         int samples = 0;
         for (const auto& [q, k] : t.samples)
             if (q == p) samples = k;
-        PassSums pass;
+        PhotonPassSums pass;
         pass.pass = p;
         pass.samples = samples;
         for (const bool odd : {false, true}) {

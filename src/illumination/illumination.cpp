@@ -139,16 +139,16 @@ bool PhotonPasses::needsWork(int pass) const {
 }
 
 bool PhotonPasses::advance(const Scene& scene, int pass, Illumination& il) const {
-    if (pass == il.pass) return false;
-    if (pass < il.pass) throw std::logic_error("PhotonPasses::advance: passes only go forward");
+    if (pass == il.photonPass) return false;
+    if (pass < il.photonPass) throw std::logic_error("PhotonPasses::advance: passes only go forward");
     // A jump over passes (a render of a later range of passes, render
     // --passes) still makes the cache refinements of the passes it skips,
     // from their own batches, so the cache of pass j is the same whichever
     // pass a render started from.
     bool changed = false;
-    for (int k = il.pass + 1; k < pass; ++k)
+    for (int k = il.photonPass + 1; k < pass; ++k)
         if (refinesCacheAt(k) && il.cache && !il.cacheLoaded) changed |= tracePass(scene, k, false, il);
-    il.pass = pass;
+    il.photonPass = pass;
     il.radiusScale = float(progressiveRadiusScale(pass, mRequest.photons.alpha));
     return tracePass(scene, pass, mRequest.indirect, il) || changed;
 }

@@ -52,7 +52,7 @@ struct Illumination {
     bool cacheLoaded = false;  // from a baked file: never refined
     // Progressive photon pass the map belongs to, and its gather radius
     // relative to the k-nearest sphere (PhotonPasses).
-    int pass = 0;
+    int photonPass = 0;
     float radiusScale = 1;
     IlluminationStats stats;
 };

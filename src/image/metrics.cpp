@@ -80,10 +80,10 @@ RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, fl
     const size_t count = test.pixelCount();
     std::vector<size_t> use;
     use.reserve(count);
-    for (int pass = 0; pass < 2 && use.empty(); ++pass)
+    for (int attempt = 0; attempt < 2 && use.empty(); ++attempt)
         for (size_t i = 0; i < count; ++i)
             if (finiteRgb(test, i) && finiteRgb(reference, i) &&
-                (pass == 1 || reference.rgba[i * 4 + 3] >= minReferenceAlpha))
+                (attempt == 1 || reference.rgba[i * 4 + 3] >= minReferenceAlpha))
                 use.push_back(i);
     RelErrorSpread s;
     s.pixels = use.size();

@@ -70,7 +70,7 @@ public:
     void array(const std::vector<T>& v) {
         bytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
     }
-    void pass(const PassSums& p) {
+    void pass(const PhotonPassSums& p) {
         array(p.L);
         array(p.T);
         array(p.oddL);
@@ -86,7 +86,7 @@ private:
     WordHash mHash;
 };
 
-nlohmann::json passHeader(const PassSums& p) { return {{"pass", p.pass}, {"samples", p.samples}, {"pixels", p.L.size()}}; }
+nlohmann::json passHeader(const PhotonPassSums& p) { return {{"pass", p.pass}, {"samples", p.samples}, {"pixels", p.L.size()}}; }
 
 // Reads the arrays back in the order they were written, never past the end.
 class Reader {
@@ -101,7 +101,7 @@ public:
         if (bytes) std::memcpy(v.data(), mData + mAt, bytes);
         mAt += bytes;
     }
-    void pass(PassSums& p, const nlohmann::json& h) {
+    void pass(PhotonPassSums& p, const nlohmann::json& h) {
         p.pass = h.at("pass").get<int>();
         p.samples = h.at("samples").get<int>();
         const size_t n = h.at("pixels").get<size_t>();
@@ -143,7 +143,7 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
           {"direct", c.aovs.direct.size()}}},
     };
     nlohmann::json passes = nlohmann::json::array();
-    for (const PassSums& p : c.passSums) passes.push_back(passHeader(p));
+    for (const PhotonPassSums& p : c.passSums) passes.push_back(passHeader(p));
     h["passes"] = passes;
     const std::string head = str(Magic, CheckpointFormat, "\n", h.dump(), "\n");
     AtomicFile file(path);
@@ -157,7 +157,7 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
         w.array(c.sums.oddT);
         w.array(c.sums.convergedAt);
         w.pass(c.open);
-        for (const PassSums& p : c.passSums) w.pass(p);
+        for (const PhotonPassSums& p : c.passSums) w.pass(p);
         w.array(c.aovs.depth);
         w.array(c.aovs.depthSamples);
         w.array(c.aovs.albedo);

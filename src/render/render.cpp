@@ -14,7 +14,7 @@
 #include "core/error.h"
 #include "core/memory.h"
 #include "core/threads.h"
-#include "marchers/marcher.h"
+#include "estimators/estimator.h"
 #include "transport/first_event.h"
 
 namespace vdbmarch {
@@ -124,7 +124,7 @@ std::vector<ExrLayer> aovLayers(const AovSet& aovs, const AovSums& s, const Pixe
 
 }  // namespace
 
-void PixelSums::fold(const PassSums& pass) {
+void PixelSums::fold(const PhotonPassSums& pass) {
     for (size_t i = 0; i < L.size(); ++i) {
         L[i] += pass.L[i].rounded();
         T[i] += double(float(pass.T[i]));
@@ -209,7 +209,7 @@ struct NoiseTotals {
 // mean(s_b) / k), with k set so that this MSE meets the target: a block
 // stops (sums.convergedAt) once n >= k s_b. The decisions depend only on the
 // sums, so the image is the same for any thread count.
-bool noiseTargetStep(PixelSums& sums, const PassSums& open, float noise, int ww, int wh, int n) {
+bool noiseTargetStep(PixelSums& sums, const PhotonPassSums& open, float noise, int ww, int wh, int n) {
     const size_t pixels = size_t(ww) * size_t(wh);
     std::vector<float> perSample(pixels);  // variance of one sample, RGB summed
     NoiseTotals totals;
@@ -283,8 +283,8 @@ std::pair<int, int> samplesOfPasses(const Scene& scene, const PhotonPasses& phot
 // in the window's buffers): its radiance into the open pass's sums and its
 // odd half, and with AOVs the direct part and the first event's features. A
 // non-finite sample is dropped and counted, never written.
-void addCameraSample(const Scene& scene, const Marcher& marcher, ThreadContext& ctx, int x, int y, uint64_t pixel,
-                     int s, size_t local, PassSums& open, AovSums& aovSums) {
+void addCameraSample(const Scene& scene, const Estimator& marcher, ThreadContext& ctx, int x, int y, uint64_t pixel,
+                     int s, size_t local, PhotonPassSums& open, AovSums& aovSums) {
     const RenderSettings& rs = scene.desc.render;
     const AovSet& aovs = rs.aovs;
     Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
@@ -380,8 +380,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const int totalPasses = photonPasses.passOf(std::max(0, rs.spp - 1)) + 1;
     const int totalPhotonPasses = timed ? 0 : totalPasses;
     int first = 0, last = rs.spp;
-    if (options.passes)
-        std::tie(first, last) = samplesOfPasses(scene, photonPasses, *options.passes, timed, totalPasses, ww, wh);
+    if (options.photonPassRange)
+        std::tie(first, last) = samplesOfPasses(scene, photonPasses, *options.photonPassRange, timed, totalPasses, ww, wh);
 
     const int workBlocksX = (ww + WorkBlockSize - 1) / WorkBlockSize, workBlocksY = (wh + WorkBlockSize - 1) / WorkBlockSize;
     const int workBlocks = workBlocksX * workBlocksY;
@@ -390,7 +390,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     result.totalPhotonPasses = totalPhotonPasses;
     result.firstSample = first;
     PixelSums sums(pixels);
-    PassSums open;  // the sums of the pass being rendered
+    PhotonPassSums open;  // the sums of the pass being rendered
     open.pass = -1;
     AovSums aovSums(aovs, pixels);
     // Adaptive sampling towards the noise target (render.noise).
@@ -407,10 +407,10 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // Photons and the cache count in the time budget: an equal-time
     // comparison charges the guided marcher for its cache.
     std::shared_ptr<Illumination> illumination;
-    std::unique_ptr<Marcher> marcher;
+    std::unique_ptr<Estimator> marcher;
     arena.execute([&] {
         illumination = std::make_shared<Illumination>(buildIllumination(scene, request));
-        marcher = makeMarcher(rs.method, scene, illumination);
+        marcher = makeEstimator(rs.method, scene, illumination);
     });
     const double firstIlluminationSeconds = illumination->stats.seconds;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
@@ -439,10 +439,10 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             std::chrono::duration<double>(resumedSeconds));
     }
 
-    // One pass renders samples [s0, s1) of every pixel. Each pixel sums its
+    // One sweep renders samples [s0, s1) of every pixel. Each pixel sums its
     // samples in index order, so the image depends only on the final sample
-    // count, never on how samples were split into passes or threads.
-    auto renderPass = [&](int s0, int s1) {
+    // count, never on how samples were split into sweeps or threads.
+    auto renderSweep = [&](int s0, int s1) {
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<int>(0, workBlocks, 1), [&](const tbb::blocked_range<int>& range) {
                 for (int workBlock = range.begin(); workBlock != range.end(); ++workBlock) {
@@ -463,18 +463,18 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         });
     };
 
-    // A pass's sums are folded into the totals when the next pass starts and
-    // at the end (and kept apart with options.passes).
-    auto closePass = [&] {
+    // A photon pass's sums are folded into the totals when the next pass
+    // starts and at the end (and kept apart with options.photonPassRange).
+    auto closePhotonPass = [&] {
         if (open.pass < 0) return;
         sums.fold(open);
-        if (options.passes) result.passSums.push_back(std::move(open));
-        open = PassSums();
+        if (options.photonPassRange) result.passSums.push_back(std::move(open));
+        open = PhotonPassSums();
         open.pass = -1;
     };
-    auto openPass = [&](int pass, int samples) {
+    auto openPhotonPass = [&](int pass, int samples) {
         if (open.pass != pass) {
-            closePass();
+            closePhotonPass();
             open.pass = pass;
             open.L.assign(pixels, ColorSum());
             open.T.assign(pixels, 0.0);
@@ -490,15 +490,15 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     auto renderSamples = [&](int s0, int s1) {
         for (int s = s0; s < s1;) {
             const int pass = photonPasses.passOf(s);
-            if (pass != illumination->pass) {
+            if (pass != illumination->photonPass) {
                 arena.execute([&] {
                     if (photonPasses.advance(scene, pass, *illumination))
-                        marcher = makeMarcher(rs.method, scene, illumination);
+                        marcher = makeEstimator(rs.method, scene, illumination);
                 });
             }
             const int end = std::min(s1, photonPasses.progressive() ? photonPasses.firstSampleOf(pass + 1) : s1);
-            openPass(pass, end - s);
-            renderPass(s, end);
+            openPhotonPass(pass, end - s);
+            renderSweep(s, end);
             s = end;
         }
     };
@@ -532,8 +532,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         struct GiveBack {
             RenderCheckpoint& c;
             PixelSums& sums;
-            PassSums& open;
-            std::vector<PassSums>& passSums;
+            PhotonPassSums& open;
+            std::vector<PhotonPassSums>& passSums;
             AovSums& aovs;
             ~GiveBack() {
                 sums = std::move(c.sums);
@@ -581,11 +581,11 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         }
         spp = s - first;
     } else {
-        // Whole passes of one sample per pixel while the next one is expected
+        // Whole sweeps of one sample per pixel while the next one is expected
         // to finish within the budget (which also covers loading, measured
-        // from runStart); always at least one pass. A sample that starts a
+        // from runStart); always at least one sweep. A sample that starts a
         // photon pass is expected to take as long as the first photons did.
-        double lastPass = 0;
+        double lastSweep = 0;
         do {
             if (checkpointAt(first + spp)) {
                 result.interrupted = true;
@@ -597,14 +597,14 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             ++spp;
             auto now = std::chrono::steady_clock::now();
             // The camera part of the sample (photons are predicted apart).
-            lastPass = std::chrono::duration<double>(now - p0).count() - (illumination->stats.seconds - photonsBefore);
+            lastSweep = std::chrono::duration<double>(now - p0).count() - (illumination->stats.seconds - photonsBefore);
             double elapsed = std::chrono::duration<double>(now - runStart).count();
             progress.set(elapsed / options.timeBudget);
             if (checkNoise(spp)) break;
             const int next = photonPasses.passOf(spp);
             const double nextPhotons =
-                next != illumination->pass && photonPasses.needsWork(next) ? firstIlluminationSeconds : 0.0;
-            if (elapsed + 1.05 * lastPass + nextPhotons > options.timeBudget * 0.98) break;
+                next != illumination->photonPass && photonPasses.needsWork(next) ? firstIlluminationSeconds : 0.0;
+            if (elapsed + 1.05 * lastSweep + nextPhotons > options.timeBudget * 0.98) break;
         } while (spp < (1 << 24));
         progress.set(1.0);
     }
@@ -615,8 +615,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     }
     result.illuminationSeconds = illumination->stats.seconds;
     result.photons = illumination->stats.photons;
-    result.photonPasses = illumination->pass + 1;
-    closePass();
+    result.photonPasses = illumination->photonPass + 1;
+    closePhotonPass();
     result.image = sums.average(ww, wh);
     result.layers = aovLayers(aovs, aovSums, sums);
     result.noise = estimateNoise(sums, first);

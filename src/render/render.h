@@ -34,7 +34,7 @@ struct CheckpointHooks {
 
 struct RenderOptions {
     bool progress = false;  // progress bar on stderr
-    // > 0: render whole passes of one sample per pixel until this many
+    // > 0: render whole sweeps of one sample per pixel until this many
     // seconds (counted from runStart, so loading is included) are spent,
     // instead of render.spp samples.
     double timeBudget = 0;
@@ -48,7 +48,7 @@ struct RenderOptions {
     // Render only the camera samples of photon passes [first, second)
     // (render --passes): the part of a progressive render one machine takes.
     // The result keeps each pass's sums (RenderResult::passSums) for merge.
-    std::optional<std::pair<int, int>> passes;
+    std::optional<std::pair<int, int>> photonPassRange;
     std::optional<CheckpointHooks> checkpoint;
     // Keep the two half renders in the result (the denoiser's input).
     bool keepHalves = false;
@@ -71,7 +71,7 @@ struct ColorSum {
 // The sums of one photon pass's samples per pixel, radiance and
 // transmittance, each summed in sample order from zero, in double; a pass is
 // stored (in a part file) and folded as the float rounding of its sums.
-struct PassSums {
+struct PhotonPassSums {
     int pass = 0;
     int samples = 0;
     std::vector<ColorSum> L;
@@ -89,14 +89,14 @@ struct PassSums {
 struct PixelSums {
     std::vector<Color> L;
     std::vector<double> T;
-    std::vector<Color> oddL;  // over the odd-index samples (PassSums::oddL)
+    std::vector<Color> oddL;  // over the odd-index samples (PhotonPassSums::oddL)
     std::vector<double> oddT;
     int samples = 0;
     // Adaptive sampling (render.noise): the samples a pixel had when it
     // stopped receiving more; 0 while it still samples (or without it).
     std::vector<int> convergedAt;
     explicit PixelSums(size_t pixels) : L(pixels, Color(0)), T(pixels, 0.0), oddL(pixels, Color(0)), oddT(pixels, 0.0) {}
-    void fold(const PassSums& pass);
+    void fold(const PhotonPassSums& pass);
     // Samples in pixel p's sums.
     int samplesOf(size_t p) const { return convergedAt.empty() || convergedAt[p] == 0 ? samples : convergedAt[p]; }
     // RGB = L / samples, alpha = 1 - T / samples.
@@ -141,8 +141,8 @@ struct RenderCheckpoint {
     double seconds = 0;   // the run's time so far (counts in --time)
     RenderCounters counters;
     PixelSums sums{0};
-    PassSums open;                    // the pass being rendered (pass -1: none)
-    std::vector<PassSums> passSums;   // with RenderOptions::passes: the passes closed so far
+    PhotonPassSums open;                    // the pass being rendered (pass -1: none)
+    std::vector<PhotonPassSums> passSums;   // with RenderOptions::photonPassRange: the passes closed so far
     AovSums aovs;
 };
 
@@ -165,8 +165,8 @@ struct RenderResult {
     // The AOVs render.aovs asks for, as EXR layers (docs/aovs.md), in the
     // order depth, albedo, normal, direct, indirect.
     std::vector<ExrLayer> layers;
-    std::vector<PassSums> passSums;  // with RenderOptions::passes: each pass rendered, in order
-    int firstSample = 0;             // of the samples rendered (0 unless RenderOptions::passes)
+    std::vector<PhotonPassSums> passSums;  // with RenderOptions::photonPassRange: each pass rendered, in order
+    int firstSample = 0;             // of the samples rendered (0 unless RenderOptions::photonPassRange)
     int totalPhotonPasses = 1;       // the passes of the whole render.spp
     // A checkpoint stop (CheckpointHooks::stopRequested): the state was
     // saved at sample `spp` and nothing else is valid.

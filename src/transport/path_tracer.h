@@ -49,7 +49,7 @@ struct PathState {
     int splitLimit = MaxSplitPaths;
 };
 
-// What a path brings back: a camera path's result (Marcher::radiance) and a
+// What a path brings back: a camera path's result (Estimator::radiance) and a
 // continuation's alike.
 struct PathRadiance {
     Color L;                  // radiance arriving at ray.o along -ray.d

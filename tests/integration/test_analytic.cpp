@@ -126,7 +126,7 @@ TEST_P(SingleScatteringSlab, MatchesClosedForm) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Anisotropy, SingleScatteringSlab,
-                         ::testing::Combine(::testing::Values(0.f, 0.9f, -0.9f), ::testing::ValuesIn(marcherMethods())),
+                         ::testing::Combine(::testing::Values(0.f, 0.9f, -0.9f), ::testing::ValuesIn(estimatorMethods())),
                          [](const auto& info) {
                              float g = std::get<0>(info.param);
                              return std::string(methodName(std::get<1>(info.param))) +
@@ -170,7 +170,7 @@ TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, Determinism,
-                         ::testing::Combine(::testing::ValuesIn(marcherMethods()),
+                         ::testing::Combine(::testing::ValuesIn(estimatorMethods()),
                                             ::testing::Values(LiSource::Path, LiSource::Photons)),
                          methodLiName);
 
@@ -194,7 +194,7 @@ TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
     EXPECT_EQ(a.shadowSamples, b.shadowSamples);
 }
 
-// A time budget renders whole passes of one sample per pixel; the image is the
+// A time budget renders whole sweeps of one sample per pixel; the image is the
 // same, bit for bit, as a render of that many samples per pixel (for guided,
 // the cache lookups along a ray must not depend on earlier rays).
 class TimeBudget : public ::testing::TestWithParam<std::tuple<Method, LiSource>> {};
@@ -219,7 +219,7 @@ TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget,
-                         ::testing::Combine(::testing::ValuesIn(marcherMethods()),
+                         ::testing::Combine(::testing::ValuesIn(estimatorMethods()),
                                             ::testing::Values(LiSource::Path, LiSource::Photons)),
                          methodLiName);
 
@@ -362,7 +362,7 @@ TEST_P(VdbSingleScattering, MatchesClosedFormAlongTheAxis) {
     EXPECT_NEAR(s.mean, expected, 4 * s.stdError + 1e-3 * expected) << methodName(GetParam());
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, VdbSingleScattering, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, VdbSingleScattering, ::testing::ValuesIn(estimatorMethods()), methodParamName);
 
 // The reference's emission estimator (sigma_a L_e / sigma_maj at tentative
 // collisions) against the closed form of an absorbing, emitting VDB box.

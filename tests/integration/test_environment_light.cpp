@@ -117,7 +117,7 @@ TEST_P(EnvironmentLight, SmallPatchMatchesTheDirectionalLight) {
     EXPECT_NEAR(r.d.mean(), 0.0, 4 * r.d.stdError() + 0.01 * r.mean.mean()) << methodName(m);
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, EnvironmentLight, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, EnvironmentLight, ::testing::ValuesIn(estimatorMethods()), methodParamName);
 
 }  // namespace
 }  // namespace vdbmarch

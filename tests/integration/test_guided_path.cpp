@@ -20,7 +20,7 @@
 #include <optional>
 
 #include "illumination/illumination.h"
-#include "marchers/cache_path_guide.h"
+#include "estimators/cache_path_guide.h"
 #include "support/support.h"
 #include "transport/media_point.h"
 #include "transport/thread_context.h"

@@ -12,7 +12,7 @@
 
 #include "core/blackbody.h"
 #include "core/error.h"
-#include "marchers/marcher.h"
+#include "estimators/estimator.h"
 #include "illumination/illumination.h"
 #include "render/render.h"
 #include "support/support.h"
@@ -96,7 +96,7 @@ std::string furnaceName(const ::testing::TestParamInfo<std::tuple<Method, LiSour
 
 std::vector<std::tuple<Method, LiSource>> furnaceCases() {
     std::vector<std::tuple<Method, LiSource>> cases;
-    for (Method m : marcherMethods())
+    for (Method m : estimatorMethods())
         for (LiSource li : {LiSource::Path, LiSource::Photons})
             if (!isPathTracer(m) || li == LiSource::Path) cases.push_back({m, li});  // path tracers have no L_i source
     return cases;
@@ -144,7 +144,7 @@ TEST(ContinuationPaths, AgreeWithTheReferenceOnAVdbCloud) {
     // Guided twice: continuation directions from the phase, and from phase x
     // cached radiance (product sampling, with its MIS against sphere lights).
     std::vector<std::pair<Method, bool>> cases;
-    for (Method m : marcherMethods())
+    for (Method m : estimatorMethods())
         if (m != Method::Reference) cases.push_back({m, false});
     cases.push_back({Method::Guided, true});
     for (auto [m, product] : cases) {

@@ -14,7 +14,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
-#include "marchers/marcher.h"
+#include "estimators/estimator.h"
 #include "render/render.h"
 #include "support/support.h"
 
@@ -68,7 +68,7 @@ struct Run {
 
 std::vector<Run> marcherRuns() {
     std::vector<Run> runs;
-    for (Method m : marcherMethods()) {
+    for (Method m : estimatorMethods()) {
         if (m == Method::Reference) continue;
         if (m == Method::Uniform) runs.push_back({m, 4, {"render.step=0.01"}});
         else runs.push_back({m, 32, {}});
@@ -88,8 +88,9 @@ void checkAgreement(const std::string& name, const std::string& sceneFile, const
         // No allowance where no photon enters the estimate: the methods
         // without a cache trace none (guided and guided_path build their guide
         // from photons, which shapes only their pdfs).
-        if (photonBias == 0 && (run.method == Method::Uniform || run.method == Method::Transmittance))
+        if (photonBias == 0 && (run.method == Method::Uniform || run.method == Method::Transmittance)) {
             EXPECT_EQ(r.photons, 0u) << methodName(run.method);
+        }
         Agreement a = compare(r.image, ref);
         EXPECT_NEAR(a.meanDiff, 0.0, 4 * a.stdError + photonBias * a.mean) << name << ": " << methodName(run.method);
         if (std::getenv("VDBMARCH_VERBOSE"))

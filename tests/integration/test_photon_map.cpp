@@ -11,7 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include "core/sampling.h"
-#include "marchers/marcher.h"
+#include "estimators/estimator.h"
 #include "photons/photon_map.h"
 #include "photons/photon_tracer.h"
 #include "support/support.h"
@@ -75,7 +75,7 @@ Estimate meanAndError(const std::vector<double>& v) {
 // reference tracer: phase-sample the light's travel direction t' around wo
 // and take the radiance arriving along it.
 Estimate referenceIndirect(const Scene& scene, const Vec3& x, const Vec3& wo, float g, int samples) {
-    auto tracer = makeMarcher(Method::Reference, scene);
+    auto tracer = makeEstimator(Method::Reference, scene);
     ThreadContext ctx(scene);
     std::vector<double> v;
     v.reserve(size_t(samples));

@@ -13,7 +13,7 @@
 #include <fstream>
 
 #include "core/error.h"
-#include "marchers/marcher.h"
+#include "estimators/estimator.h"
 #include "render/render.h"
 #include "scene/scene.h"
 #include "support/support.h"
@@ -150,7 +150,7 @@ TEST(SmoothGlass, ReferenceSeesTheShadingNormals) {
 
 TEST(SmoothGlass, EveryMethodAgreesWithTheReference) {
     const Image ref = render(true, true, Method::Reference, 512, 11);
-    for (Method m : marcherMethods()) {
+    for (Method m : estimatorMethods()) {
         if (m == Method::Reference) continue;
         const Image img = render(true, true, m, m == Method::Uniform ? 8 : 48, 12);
         const BlockAgreement a = compareBlocks(img, ref, Block);

@@ -74,7 +74,7 @@ TEST(Glass, IndexMatchedGlassLetsShadowRaysThrough) {
             "surfaces": [{"shape": "sphere", "material": )" + material + R"(, "interior": "m"}],
             "render": {"method": ")" + std::string(methodName(method)) + R"(", "spp": 4, "step": 0.01, "seed": 5}})");
     };
-    for (Method method : marcherMethods()) {
+    for (Method method : estimatorMethods()) {
         SCOPED_TRACE(methodName(method));
         RenderResult a = renderImage(*scene(R"({"type": "interface"})", method));
         RenderResult b = renderImage(*scene(R"({"type": "dielectric", "ior": 1})", method));

@@ -124,7 +124,7 @@ TEST_P(AovMethods, DirectLayerIsSingleScattering) {
         << singleSum / double(single.image.pixelCount());
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, AovMethods, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, AovMethods, ::testing::ValuesIn(estimatorMethods()), methodParamName);
 
 // An orthographic camera 2 units in front of a slab face, in a medium of
 // extinction 1000 and albedo 0.8: every sample's first event is an

@@ -105,13 +105,13 @@ TEST_P(CheckpointMethods, ResumedRenderIsBitIdentical) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, CheckpointMethods, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, CheckpointMethods, ::testing::ValuesIn(estimatorMethods()), methodParamName);
 
 TEST(Checkpoint, APartByPhotonPassesResumesBitIdentical) {
     TempDir dir("checkpoint");
     const auto scene = smallScene(Method::Guided);
     RenderOptions options;
-    options.passes = std::make_pair(1, 4);  // samples 2-7
+    options.photonPassRange = std::make_pair(1, 4);  // samples 2-7
     const RenderResult whole = renderImage(*scene, options);
     ASSERT_EQ(whole.passSums.size(), 3u);
     const RenderCheckpoint state = interrupted(*scene, options, 4, dir / "ck");  // samples 2-4 done

@@ -84,7 +84,7 @@ TEST_P(TileMethods, CropIsBitIdenticalToItsPartOfTheWholeFrame) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, TileMethods, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, TileMethods, ::testing::ValuesIn(estimatorMethods()), methodParamName);
 
 TEST(Tiles, CropOutsideTheFrameIsRefused) {
     RenderOptions options;

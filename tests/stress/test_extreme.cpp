@@ -148,7 +148,7 @@ TEST_P(StressScenes, NoEnergyCreatedInAFurnace) {
     EXPECT_LE(s.mean, 1.0 + 4 * s.stdError);
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, StressScenes, ::testing::ValuesIn(marcherMethods()), methodParamName);
+INSTANTIATE_TEST_SUITE_P(Methods, StressScenes, ::testing::ValuesIn(estimatorMethods()), methodParamName);
 
 // Voxel sizes 1e-4 and 1e4 and a world offset of 1e5: the same box in voxel
 // units (20^3 voxels of density 1, optical depth 2 across) must give the same
@@ -191,7 +191,7 @@ std::string scaleStressName(const ::testing::TestParamInfo<ScaleStress::ParamTyp
 INSTANTIATE_TEST_SUITE_P(Scales, ScaleStress,
                          ::testing::Combine(::testing::Values(std::make_pair(1e-4, 0.0), std::make_pair(1e4, 0.0),
                                                               std::make_pair(1.0, 1e5), std::make_pair(1e4, 1e5)),
-                                            ::testing::ValuesIn(marcherMethods())),
+                                            ::testing::ValuesIn(estimatorMethods())),
                          scaleStressName);
 
 }  // namespace

@@ -26,7 +26,7 @@
 #include "core/math.h"
 #include "core/error.h"
 #include "image/image.h"
-#include "marchers/marcher.h"
+#include "estimators/estimator.h"
 #include "parse/method.h"
 #include "parse/scene_desc.h"
 #include "render/render.h"
@@ -329,7 +329,7 @@ LightDesc sphereLight(const Vec3& p, float radius, const Color& power);
 // ---------------------------------------------------------------------------
 // Methods
 
-// Test names for suites over `::testing::ValuesIn(marcherMethods())`.
+// Test names for suites over `::testing::ValuesIn(estimatorMethods())`.
 std::string methodParamName(const ::testing::TestParamInfo<Method>& info);
 // The --set override that selects `m`: render.method="<name>".
 std::string methodOverride(Method m);

@@ -12,8 +12,8 @@
 #include "cache/cache_lookup.h"
 #include "cache/product_sampler.h"
 #include "illumination/illumination.h"
-#include "marchers/marcher.h"
-#include "marchers/ray_pdf.h"
+#include "estimators/estimator.h"
+#include "estimators/ray_pdf.h"
 #include "transport/direct_light.h"
 #include "transport/media_point.h"
 
@@ -44,7 +44,7 @@ struct MarcherScratch final : ThreadContextExtension {
         double scatter = 0;
         double inScattered = 0, transmittance = 1;  // FlightEstimate
     } flight;
-    // The guided marcher's pre-pass (eq. 17's scale): march without sampling
+    // The guided marcher's probe of eq. 17's scale: march without sampling
     // and sum each segment's throughput times its histogram integral.
     bool measureOnly = false;
     double measuredGuided = 0;
@@ -66,7 +66,7 @@ struct MarcherScratch final : ThreadContextExtension {
                              ScatterVertex& vertex);
 };
 
-class SegmentMarcher : public Marcher {
+class SegmentMarcher : public Estimator {
 public:
     SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination);
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;

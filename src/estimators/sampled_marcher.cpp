@@ -23,14 +23,14 @@
 //
 // Guided allots N per segment by eq. 17: proportional to the segment's
 // expected in-scattering sum(h sigma_s T S) times the path throughput,
-// relative to its mean over the segments through media (a pre-pass of
+// relative to its mean over the segments through media (a probe of
 // camera rays), between
 // render.ray_samples / 4 and 8 render.ray_samples; transmittance always takes
 // render.ray_samples. Emission is integrated on the steps, as uniform does.
 #include <algorithm>
 #include <cmath>
 
-#include "marchers/segment_marcher.h"
+#include "estimators/segment_marcher.h"
 #include "transport/roulette.h"
 
 namespace vdbmarch {
@@ -39,7 +39,7 @@ namespace {
 
 constexpr int MinSamplesDivisor = 4;  // guided: at least ray_samples / 4 per segment (and 1)
 constexpr int MaxSamplesFactor = 8;   // guided: at most 8 ray_samples per segment
-constexpr int PrepassWidth = 32, PrepassHeight = 24;
+constexpr int ProbeWidth = 32, ProbeHeight = 24;
 
 class SampledMarcher final : public SegmentMarcher {
 public:
@@ -57,10 +57,10 @@ private:
         MarcherScratch& m = scratch(ctx);
         m.measureOnly = true;
         const int w = mScene.camera->width(), h = mScene.camera->height();
-        for (int j = 0; j < PrepassHeight; ++j)
-            for (int i = 0; i < PrepassWidth; ++i) {
-                Rng rng(hashValues(0x707265706173, uint64_t(j * PrepassWidth + i)));
-                float x = (float(i) + 0.5f) * float(w) / PrepassWidth, y = (float(j) + 0.5f) * float(h) / PrepassHeight;
+        for (int j = 0; j < ProbeHeight; ++j)
+            for (int i = 0; i < ProbeWidth; ++i) {
+                Rng rng(hashValues(0x707265706173, uint64_t(j * ProbeWidth + i)));
+                float x = (float(i) + 0.5f) * float(w) / ProbeWidth, y = (float(j) + 0.5f) * float(h) / ProbeHeight;
                 radiance(mScene.camera->generateRay(x, y), rng, ctx);
             }
         // Per segment through a scattering medium, not per camera ray: rays
@@ -198,11 +198,11 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Marcher> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
+std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
     return std::make_unique<SampledMarcher>(scene, std::move(il), false);
 }
 
-std::unique_ptr<Marcher> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
+std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
     return std::make_unique<SampledMarcher>(scene, std::move(il), true);
 }
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/rng.h"
-#include "marchers/ray_pdf.h"
+#include "estimators/ray_pdf.h"
 #include "support/support.h"
 
 namespace vdbmarch {

@@ -1,4 +1,4 @@
-#include "marchers/segment_marcher.h"
+#include "estimators/segment_marcher.h"
 
 #include <cmath>
 

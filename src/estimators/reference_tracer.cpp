@@ -9,8 +9,8 @@
 // (cache_path_guide.h): free flights, and with render.product_sampling
 // directions, drawn towards where the cache says the light is.
 #include "illumination/illumination.h"
-#include "marchers/cache_path_guide.h"
-#include "marchers/marcher.h"
+#include "estimators/cache_path_guide.h"
+#include "estimators/estimator.h"
 #include "transport/path_tracer.h"
 #include "transport/surface_event.h"
 
@@ -18,7 +18,7 @@ namespace vdbmarch {
 
 namespace {
 
-class ReferenceTracer final : public Marcher {
+class ReferenceTracer final : public Estimator {
 public:
     ReferenceTracer(const Scene& s, std::shared_ptr<const Illumination> il = nullptr)
         : mScene(s), mChromatic(hasChromaticExtinction(s)), mIllumination(std::move(il)) {
@@ -50,11 +50,11 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Marcher> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination>) {
+std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination>) {
     return std::make_unique<ReferenceTracer>(scene);
 }
 
-std::unique_ptr<Marcher> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
+std::unique_ptr<Estimator> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
     return std::make_unique<ReferenceTracer>(scene, std::move(il));
 }
 

@@ -1,4 +1,4 @@
-#include "marchers/marcher.h"
+#include "estimators/estimator.h"
 
 #include "core/error.h"
 #include "illumination/illumination.h"
@@ -8,10 +8,10 @@ namespace vdbmarch {
 namespace {
 struct Entry {
     Method method;
-    std::unique_ptr<Marcher> (*make)(const Scene&, std::shared_ptr<const Illumination>);
+    std::unique_ptr<Estimator> (*make)(const Scene&, std::shared_ptr<const Illumination>);
 };
 // The factory table: one line per method.
-const Entry kMarchers[] = {
+const Entry kEstimators[] = {
     {Method::Uniform, makeUniformMarcher},
     {Method::Transmittance, makeTransmittanceMarcher},
     {Method::Guided, makeGuidedMarcher},
@@ -20,14 +20,14 @@ const Entry kMarchers[] = {
 };
 }  // namespace
 
-std::vector<Method> marcherMethods() {
+std::vector<Method> estimatorMethods() {
     std::vector<Method> methods;
-    for (const auto& e : kMarchers) methods.push_back(e.method);
+    for (const auto& e : kEstimators) methods.push_back(e.method);
     return methods;
 }
 
-std::unique_ptr<Marcher> makeMarcher(Method method, const Scene& scene, std::shared_ptr<const Illumination> illumination) {
-    for (const auto& e : kMarchers)
+std::unique_ptr<Estimator> makeEstimator(Method method, const Scene& scene, std::shared_ptr<const Illumination> illumination) {
+    for (const auto& e : kEstimators)
         if (method == e.method) {
             if (!illumination) illumination = std::make_shared<Illumination>(prepareIllumination(scene, method));
             return e.make(scene, std::move(illumination));

@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "marchers/segment_marcher.h"
+#include "estimators/segment_marcher.h"
 #include "transport/roulette.h"
 
 namespace vdbmarch {
@@ -66,7 +66,7 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Marcher> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
+std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
     return std::make_unique<UniformMarcher>(scene, std::move(il));
 }
 

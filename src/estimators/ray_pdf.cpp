@@ -1,4 +1,4 @@
-#include "marchers/ray_pdf.h"
+#include "estimators/ray_pdf.h"
 
 #include <algorithm>
 #include <cmath>

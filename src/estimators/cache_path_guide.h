@@ -13,7 +13,7 @@
 // h the cached in-scattered radiance towards the ray's origin in the bin
 // (CacheLookup), a truncated exponential inside the bin, with probability
 // P_s = 1 - T~(tEnd) (the analog probability of a collision; at most
-// 1 - MinPass); else the path passes to tEnd. A small floor on every bin's
+// 1 - MinPassThrough); else the path passes to tEnd. A small floor on every bin's
 // weight keeps the support whole where a midpoint misses a gridded
 // medium's density. The weights use the true sigma_s at the collision and
 // T by ratio tracking, so the estimator is unbiased for any cache, in

@@ -1,9 +1,9 @@
-#include "marchers/cache_path_guide.h"
+#include "estimators/cache_path_guide.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "marchers/segment_marcher.h"
+#include "estimators/segment_marcher.h"
 #include "transport/path_tracer.h"
 #include "transport/tracking.h"
 #include "transport/transmittance.h"
@@ -19,7 +19,7 @@ constexpr float FlightDefensive = 0.25f;
 constexpr int MaxFlightBins = 256;
 // Least probability of passing a segment: T~ may underestimate T where
 // gridded density varies inside a bin.
-constexpr double MinPass = 0.01;
+constexpr double MinPassThrough = 0.01;
 // Every bin keeps at least this share of the mean scattering weight per
 // unit length, so no bin of an active interval has probability 0.
 constexpr double BinFloor = 1e-3;
@@ -105,7 +105,7 @@ public:
         f.ray = ray;
         f.region = region;
         f.tEnd = tEnd;
-        f.scatter = std::min(-std::expm1(-tau), 1 - MinPass);
+        f.scatter = std::min(-std::expm1(-tau), 1 - MinPassThrough);
         f.inScattered = m.rayPdf.guidedIntegral();
         f.transmittance = std::exp(-tau);
         return f.scatter > 0;
