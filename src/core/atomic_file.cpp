@@ -67,7 +67,7 @@ void splitPath(const std::string& path, std::string& dir, std::string& name) {
 AtomicFile::AtomicFile(std::string finalPath) : mFinalPath(std::move(finalPath)) {
     std::string dir, name;
     splitPath(mFinalPath, dir, name);
-    if (name.empty()) throw IoError(str("cannot write '", mFinalPath, "': not a file name"));
+    if (name.empty()) throw IoError(str(mFinalPath, ": cannot write: not a file name"));
     // pid + per-process counter keeps concurrent writers (threads or
     // processes) from sharing a temporary file.
     mTempPath = str(dir == "/" ? "" : dir, "/.", name, ".tmp-", ::getpid(), "-", gTempCounter++);
@@ -126,15 +126,15 @@ void AtomicFile::commit() {
     // at an empty file on some file systems.
     int fd = ::open(mTempPath.c_str(), O_RDONLY);
     if (fd < 0)
-        throw IoError(str("cannot write '", mFinalPath, "': temporary file '", mTempPath,
+        throw IoError(str(mFinalPath, ": cannot write: temporary file '", mTempPath,
                           "': ", std::strerror(errno)));
     bool synced = ::fsync(fd) == 0 || errno == EINVAL;  // EINVAL: fs without fsync
     int syncErr = errno;
     ::close(fd);
     if (!synced)
-        throw IoError(str("cannot write '", mFinalPath, "': ", std::strerror(syncErr)));
+        throw IoError(str(mFinalPath, ": cannot write: ", std::strerror(syncErr)));
     if (std::rename(mTempPath.c_str(), mFinalPath.c_str()) != 0)
-        throw IoError(str("cannot write '", mFinalPath, "': rename from '", mTempPath,
+        throw IoError(str(mFinalPath, ": cannot write: rename from '", mTempPath,
                           "' failed: ", std::strerror(errno)));
     mCommitted = true;
 }
@@ -142,17 +142,17 @@ void AtomicFile::commit() {
 void checkWritable(const std::string& path) {
     std::string dir, name;
     splitPath(path, dir, name);
-    if (name.empty()) throw IoError(str("cannot write '", path, "': not a file name"));
+    if (name.empty()) throw IoError(str(path, ": cannot write: not a file name"));
     struct stat st;
     if (::stat(dir.c_str(), &st) != 0)
-        throw IoError(str("cannot write '", path, "': directory '", dir, "': ", std::strerror(errno)));
+        throw IoError(str(path, ": cannot write: directory '", dir, "': ", std::strerror(errno)));
     if (!S_ISDIR(st.st_mode))
-        throw IoError(str("cannot write '", path, "': '", dir, "' is not a directory"));
+        throw IoError(str(path, ": cannot write: '", dir, "' is not a directory"));
     // Write + search permission are what creating and renaming the temp file need.
     if (::access(dir.c_str(), W_OK | X_OK) != 0)
-        throw IoError(str("cannot write '", path, "': directory '", dir, "': ", std::strerror(errno)));
+        throw IoError(str(path, ": cannot write: directory '", dir, "': ", std::strerror(errno)));
     if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-        throw IoError(str("cannot write '", path, "': it is a directory"));
+        throw IoError(str(path, ": cannot write: it is a directory"));
 }
 
 void writeTextFileAtomic(const std::string& path, const std::string& text) {
@@ -160,7 +160,7 @@ void writeTextFileAtomic(const std::string& path, const std::string& text) {
     {
         std::ofstream out(f.tempPath(), std::ios::binary);
         out << text;
-        if (!out) throw IoError(str("cannot write '", path, "'"));
+        if (!out) throw IoError(str(path, ": cannot write"));
     }
     f.commit();
 }

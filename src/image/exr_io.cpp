@@ -44,10 +44,10 @@ const char* const RgbaNames[4] = {"R", "G", "B", "A"};
 // compression (a wide margin: a constant 16k x 16k RGBA image still passes).
 void checkDataWindowFits(const std::string& path, int64_t w, int64_t h, int channels, uint64_t fileBytes) {
     if (w <= 0 || h <= 0 || w > (1 << 30) / h)
-        throw InputError(str("'", path, "' has an unsupported data window of ", w, "x", h));
+        throw InputError(str(path, ": unsupported data window of ", w, "x", h));
     const uint64_t minSampleBytes = uint64_t(w) * uint64_t(h) * 2 * uint64_t(std::max(1, channels));
     if ((minSampleBytes >> 20) > fileBytes)
-        throw InputError(str("'", path, "' claims a ", w, "x", h, " data window that a file of ", fileBytes,
+        throw InputError(str(path, ": the header claims a ", w, "x", h, " data window that a file of ", fileBytes,
                              " bytes cannot hold (damaged header?)"));
 }
 
@@ -81,7 +81,7 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
         s.clear();
         for (int c; (c = std::fgetc(f)) != 0;) {
             if (c == EOF || s.size() >= 255)
-                throw InputError(str("'", path, "': damaged OpenEXR header (an attribute name or type runs on)"));
+                throw InputError(str(path, ": damaged OpenEXR header (an attribute name or type runs on)"));
             s.push_back(char(c));
         }
     };
@@ -94,12 +94,12 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
             readString(type);
             unsigned char b[4];
             if (std::fread(b, 1, 4, f) != 4)
-                throw InputError(str("'", path, "': damaged OpenEXR header (cut inside attribute '", name, "')"));
+                throw InputError(str(path, ": damaged OpenEXR header (cut inside attribute '", name, "')"));
             const int32_t size = int32_t(uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24);
             const long pos = std::ftell(f);
             const uint64_t left = pos >= 0 && uint64_t(pos) <= fileBytes ? fileBytes - uint64_t(pos) : 0;
             if (size < 0 || uint64_t(size) > left)
-                throw InputError(str("'", path, "': damaged OpenEXR header: attribute '", name, "' (", type, ") claims ",
+                throw InputError(str(path, ": damaged OpenEXR header: attribute '", name, "' (", type, ") claims ",
                                      size, " bytes, but only ", left, " follow"));
             // OpenEXR reads the value of a type it knows by the type, not by
             // the size field (fuzzing: a channel list whose size disagreed
@@ -118,7 +118,7 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
                     if (channel.empty()) break;
                     ++channels;
                     if (std::fseek(f, 16, SEEK_CUR) != 0)
-                        throw InputError(str("'", path, "': damaged OpenEXR header (cut inside the channel list)"));
+                        throw InputError(str(path, ": damaged OpenEXR header (cut inside the channel list)"));
                 }
                 continue;
             }
@@ -129,7 +129,7 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
                 const uint64_t pw = uint64_t(wh[0]) | uint64_t(wh[1]) << 8 | uint64_t(wh[2]) << 16 | uint64_t(wh[3]) << 24;
                 const uint64_t ph = uint64_t(wh[4]) | uint64_t(wh[5]) << 8 | uint64_t(wh[6]) << 16 | uint64_t(wh[7]) << 24;
                 if (pw * ph * 4 > left)
-                    throw InputError(str("'", path, "': damaged OpenEXR header: the preview image claims ", pw, "x", ph,
+                    throw InputError(str(path, ": damaged OpenEXR header: the preview image claims ", pw, "x", ph,
                                          " pixels, but only ", left, " bytes follow"));
                 std::fseek(f, long(pw * ph * 4), SEEK_CUR);
                 continue;
@@ -143,7 +143,7 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
                     const int32_t len = int32_t(uint32_t(l[0]) | uint32_t(l[1]) << 8 | uint32_t(l[2]) << 16 | uint32_t(l[3]) << 24);
                     read += 4;
                     if (len < 0 || int64_t(len) > int64_t(size) - read)
-                        throw InputError(str("'", path, "': damaged OpenEXR header: a string of attribute '", name,
+                        throw InputError(str(path, ": damaged OpenEXR header: a string of attribute '", name,
                                              "' claims ", len, " bytes, beyond the attribute's ", size));
                     std::fseek(f, len, SEEK_CUR);
                     read += len;
@@ -177,10 +177,10 @@ void checkExrAttributeSizes(const std::string& path, std::FILE* f) {
 // that is a bad input file.
 void checkReadableExr(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw IoError(str("cannot open '", path, "': ", std::strerror(errno)));
+    if (!f) throw IoError(str(path, ": cannot open: ", std::strerror(errno)));
     std::fclose(f);
     if (!Imf::isOpenExrFile(path.c_str()))
-        throw InputError(str("'", path, "' is not an OpenEXR file"));
+        throw InputError(str(path, ": not an OpenEXR file"));
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
     if (file) checkExrAttributeSizes(path, file.get());
 }
@@ -195,11 +195,11 @@ auto withInputFile(const std::string& path, Fn fn) -> decltype(fn(std::declval<I
     } catch (const InputError&) {
         throw;
     } catch (const Iex::ErrnoExc& e) {
-        throw IoError(str("cannot read '", path, "': ", printableExcerpt(e.what())));
+        throw IoError(str(path, ": cannot read: ", printableExcerpt(e.what())));
     } catch (const std::bad_alloc&) {
-        throw InputError(str("cannot read OpenEXR file '", path, "': out of memory (corrupt header?)"));
+        throw InputError(str(path, ": cannot read OpenEXR: out of memory (corrupt header?)"));
     } catch (const std::exception& e) {
-        throw InputError(str("cannot read OpenEXR file '", path, "': ", printableExcerpt(e.what())));
+        throw InputError(str(path, ": cannot read OpenEXR: ", printableExcerpt(e.what())));
     }
 }
 
@@ -291,10 +291,10 @@ ExrContents readContents(const std::string& path, Imf::InputFile& in, bool allCh
     checkDataWindowFits(path, w, h, channels, ec ? UINT64_MAX : fileBytes);
     const int floatsPerPixel = allChannels ? std::max(4, channels + 1) : 4;
     checkMemory(uint64_t(w) * uint64_t(h) * uint64_t(floatsPerPixel) * sizeof(float),
-                str("'", path, "' (", w, "x", h, " pixels, ", floatsPerPixel, " floats each)"));
+                str(path, " (", w, "x", h, " pixels, ", floatsPerPixel, " floats each)"));
     const Imf::ChannelList& list = in.header().channels();
     for (int c = 0; c < 3; ++c)
-        if (!list.findChannel(RgbaNames[c])) throw InputError(str("'", path, "' has no ", RgbaNames[c], " channel"));
+        if (!list.findChannel(RgbaNames[c])) throw InputError(str(path, ": no ", RgbaNames[c], " channel"));
 
     ExrContents out;
     out.window.data = {dw.min.x, dw.min.y, dw.max.x + 1, dw.max.y + 1};

@@ -29,7 +29,7 @@ struct Image {
     Image() = default;
     // Zero-initialised (transparent black), so renderers can accumulate into it.
     Image(int w, int h) : width(w), height(h) {
-        if (w < 0 || h < 0) throw InputError(str("invalid image size ", w, "x", h));
+        if (w < 0 || h < 0) throw std::logic_error(str("Image: invalid size ", w, "x", h));
         rgba.assign(size_t(w) * size_t(h) * 4, 0.f);
     }
 

@@ -79,7 +79,7 @@ std::vector<uint8_t> toSrgb8(const Image& img, float exposureStops) {
 
 Image readPng(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw IoError(str("cannot open '", path, "': ", std::strerror(errno)));
+    if (!f) throw IoError(str(path, ": cannot open: ", std::strerror(errno)));
 
     png_image image;
     std::memset(&image, 0, sizeof(image));
@@ -88,7 +88,7 @@ Image readPng(const std::string& path) {
         std::string message = image.message;
         png_image_free(&image);
         std::fclose(f);
-        throw InputError(str("cannot read PNG file '", path, "': ", message));
+        throw InputError(str(path, ": cannot read PNG: ", message));
     }
     image.format = PNG_FORMAT_RGBA;  // converts grey, palette and 16-bit files
     std::vector<uint8_t> bytes(PNG_IMAGE_SIZE(image));
@@ -96,7 +96,7 @@ Image readPng(const std::string& path) {
     std::string message = image.message;
     png_image_free(&image);
     std::fclose(f);
-    if (!ok) throw InputError(str("cannot read PNG file '", path, "': ", message));
+    if (!ok) throw InputError(str(path, ": cannot read PNG: ", message));
 
     float toLinear[256];
     for (int i = 0; i < 256; ++i) toLinear[i] = srgbToLinear(i / 255.f);

@@ -42,16 +42,16 @@ std::string directoryOf(const std::string& path) {
 // makes bounds checks on binary PLY trivial.
 std::string readWholeFile(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw IoError(str("cannot open mesh file '", path, "'"));
+    if (!in) throw IoError(str(path, ": cannot open mesh file"));
     // A directory opens fine on Linux but fails to read; libstdc++ reports
     // that by throwing from the stream buffer.
     try {
         std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
         if (!in.bad()) return data;
     } catch (const std::exception& e) {
-        throw IoError(str("cannot read mesh file '", path, "': ", e.what()));
+        throw IoError(str(path, ": cannot read mesh file: ", e.what()));
     }
-    throw IoError(str("cannot read mesh file '", path, "'"));
+    throw IoError(str(path, ": cannot read mesh file"));
 }
 
 // Appends one polygon fan-triangulated (v0, vi, vi+1), after checking every

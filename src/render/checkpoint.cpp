@@ -165,7 +165,7 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
         w.array(c.aovs.direct);
         w.finish();
         out.flush();
-        if (!out) throw IoError(str("cannot write '", path, "': ", std::strerror(errno)));
+        if (!out) throw IoError(str(path, ": cannot write: ", std::strerror(errno)));
     }
     file.commit();
 }
