@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <deque>
+#include <limits>
+#include <stdexcept>
 #include <new>
 
 #include <sys/mman.h>
@@ -192,26 +194,21 @@ void PaddedBlocks::buildPiece(const openvdb::FloatGrid& grid, const Coord* origi
             summaries[b] = summarize(dst);
         }
     });
-    // Each block's place (constant blocks share one copy), then the copies.
-    std::vector<float*> places(n, nullptr);
-    for (size_t b = 0; b < n; ++b)
-        if (summaries[b].any) places[b] = summaries[b].constant ? constantBlock(scratch[b * Size]) : allocateBlock();
+    // Each block's id (constant blocks share one), in block order so that
+    // ids do not depend on the thread count, then the copies.
+    std::vector<int32_t> ids(n, 0);
+    for (size_t b = 0; b < n; ++b) {
+        const BlockSummary& s = summaries[b];
+        if (s.any)
+            ids[b] = s.constant ? constantBlock(scratch[b * Size], s.tightBox, s.maximum, s.minimum)
+                                : allocateBlock(s.tightBox, s.maximum, s.minimum);
+    }
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t b = r.begin(); b != r.end(); ++b)
             if (summaries[b].any && !summaries[b].constant)
-                std::memcpy(places[b], &scratch[b * Size], Size * sizeof(float));
+                std::memcpy(const_cast<float*>(block(ids[b])), &scratch[b * Size], Size * sizeof(float));
     });
-    for (size_t b = 0; b < n; ++b) {
-        int32_t id = 0;
-        if (summaries[b].any) {
-            blockValues.push_back(places[b]);
-            tightBox.push_back(summaries[b].tightBox);
-            blockMax.push_back(summaries[b].maximum);
-            blockMin.push_back(summaries[b].minimum);
-            id = int32_t(blockValues.size());
-        }
-        indexAccessor.addTile(1, origins[b], id, true);
-    }
+    for (size_t b = 0; b < n; ++b) indexAccessor.addTile(1, origins[b], ids[b], true);
 }
 
 void PaddedBlocks::build(openvdb::FloatGrid& grid) {
@@ -235,9 +232,9 @@ void PaddedBlocks::build(openvdb::FloatGrid& grid) {
     std::vector<Coord> piece;
     openvdb::tree::ValueAccessor<openvdb::Int32Tree> indexAccessor(index);
     // The tables hold at most one entry per block: reserved once, so no
-    // growth copies them at the end of a large build (the peak).
+    // growth copies them at the end of a large build (the peak). Pages of
+    // the reserve that no id reaches are never touched, so never resident.
     const size_t blockCount = origins.size();
-    blockValues.reserve(blockCount);
     tightBox.reserve(blockCount);
     blockMax.reserve(blockCount);
     blockMin.reserve(blockCount);
@@ -299,7 +296,7 @@ PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activ
     // Blocks with their own values per leaf, measured on the sample assets
     // and the upsampled clouds (docs/memory.md): 1.03-1.17; in all 1.06-1.27.
     const uint64_t kept = leaves * 110 / 100, all = leaves * 125 / 100;
-    const uint64_t perBlock = Size * sizeof(float) + sizeof(float*) + sizeof(uint32_t) + 2 * sizeof(float);
+    const uint64_t perBlock = Size * sizeof(float) + sizeof(uint32_t) + 2 * sizeof(float);
     const uint64_t lists = sizeof(openvdb::Coord) * (all + leaves);  // block origins, leaves in x order
     const uint64_t slabs = bounds.empty() ? 1 : uint64_t(bounds.dim().x()) / 8 + 1;
     const uint64_t scratch = 2 * all / slabs * Size * sizeof(float);  // the largest slab, taken as twice the mean
@@ -313,40 +310,55 @@ PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activ
     return f;
 }
 
-float* PaddedBlocks::allocateBlock() {
-    // Chunks of 32 MB, 2 MB aligned, with transparent huge pages asked for:
-    // the kernel then maps 2 MB per page fault, not 4 kB (in 4 kB pages the
-    // faults of a 1 GB build took 1.7 s).
-    constexpr size_t HugePage = size_t(2) << 20, ChunkBytes = size_t(32) << 20;
-    constexpr size_t BlocksPerChunk = ChunkBytes / (Size * sizeof(float));
-    if (mChunks.empty() || mChunkUsed == BlocksPerChunk) {
-        void* p = std::aligned_alloc(HugePage, ChunkBytes);
-        if (!p) throw std::bad_alloc();
+// A chunk is mapped from the system directly, 2 MB aligned, with transparent
+// huge pages asked for: the kernel then maps 2 MB per page fault, not 4 kB
+// (in 4 kB pages the faults of a 1 GB build took 1.7 s). Not from malloc,
+// whose heap would place chunks by its own thresholds among the freed
+// leaves; pages of the last chunk that no block reaches are never resident.
+constexpr size_t HugePage = size_t(2) << 20;
+static_assert(PaddedBlocks::ChunkBytes % HugePage == 0, "chunks are whole huge pages");
+
+float* PaddedBlocks::mapChunk() {
+    void* p = ::mmap(nullptr, ChunkBytes + HugePage, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    const uintptr_t start = reinterpret_cast<uintptr_t>(p);
+    const uintptr_t aligned = (start + HugePage - 1) & ~uintptr_t(HugePage - 1);
+    if (aligned > start) ::munmap(p, aligned - start);
+    if (aligned + ChunkBytes < start + ChunkBytes + HugePage)
+        ::munmap(reinterpret_cast<void*>(aligned + ChunkBytes), start + HugePage - aligned);
 #if defined(MADV_HUGEPAGE)
-        ::madvise(p, ChunkBytes, MADV_HUGEPAGE);
+    ::madvise(reinterpret_cast<void*>(aligned), ChunkBytes, MADV_HUGEPAGE);
 #endif
-        mChunks.emplace_back(static_cast<float*>(p));
-        mChunkUsed = 0;
-    }
-    mValueBytes += Size * sizeof(float);
-    return mChunks.back().get() + Size * mChunkUsed++;
+    return reinterpret_cast<float*>(aligned);
 }
 
-float* PaddedBlocks::constantBlock(float value) {
+void PaddedBlocks::UnmapChunk::operator()(float* p) const { ::munmap(p, ChunkBytes); }
+
+int32_t PaddedBlocks::allocateBlock(uint32_t box, float maximum, float minimum) {
+    const size_t slot = tightBox.size();
+    if (slot >= size_t(std::numeric_limits<int32_t>::max()))
+        throw std::length_error("PaddedBlocks: more blocks than an Int32 index holds");
+    if (slot % ChunkBlocks == 0) mChunks.emplace_back(mapChunk());
+    tightBox.push_back(box);
+    blockMax.push_back(maximum);
+    blockMin.push_back(minimum);
+    return int32_t(slot + 1);
+}
+
+int32_t PaddedBlocks::constantBlock(float value, uint32_t box, float maximum, float minimum) {
     uint32_t bits;
     std::memcpy(&bits, &value, sizeof bits);
-    std::unique_ptr<float[]>& block = mConstantBlocks[bits];
-    if (!block) {
-        block.reset(new float[Size]);
-        std::fill_n(block.get(), Size, value);
-        mValueBytes += Size * sizeof(float);
+    int32_t& id = mConstantBlocks[bits];
+    if (id == 0) {
+        id = allocateBlock(box, maximum, minimum);
+        std::fill_n(const_cast<float*>(block(id)), Size, value);
     }
-    return block.get();
+    return id;
 }
 
 uint64_t PaddedBlocks::memoryBytes() const {
-    return mValueBytes + blockValues.capacity() * sizeof(const float*) + tightBox.capacity() * sizeof(uint32_t) +
-           (blockMax.capacity() + blockMin.capacity()) * sizeof(float) + uint64_t(index.memUsage());
+    return uint64_t(blockCount()) * (Size * sizeof(float) + sizeof(uint32_t) + 2 * sizeof(float)) +
+           uint64_t(index.memUsage());
 }
 
 }  // namespace vdbmarch

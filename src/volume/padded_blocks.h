@@ -21,19 +21,27 @@ namespace vdbmarch {
 
 struct PaddedBlocks {
     static constexpr int N = 9, Size = N * N * N;
+    // Values live in chunks of 32 MiB (16 huge pages) holding ChunkBlocks
+    // blocks each (20 bytes to spare), so an id finds its values by a division
+    // by a constant, with no pointer per block.
+    static constexpr size_t ChunkBytes = size_t(32) << 20;
+    static constexpr size_t ChunkBlocks = ChunkBytes / (Size * sizeof(float));
+
 
     // One level-1 tile (an 8^3 block) per block of the grid's topology dilated
-    // by one voxel (trilinear lookups reach the +1 neighbours): block id + 1
-    // where the padded values are not all zero, 0 where they are. Every tile is
-    // active; the media's block walk (vdb_medium.cpp) visits these tiles; tiles
-    // cost no leaf (an Int32 leaf per block weighed as much as the grid).
+    // by one voxel (trilinear lookups reach the +1 neighbours): the id + 1 of
+    // the block's values where they are not all zero, 0 where they are. Blocks
+    // of one constant value share one id. Every tile is active; the media's
+    // block walk (vdb_medium.cpp) visits these tiles; tiles cost no leaf (an
+    // Int32 leaf per block weighed as much as the grid).
     openvdb::Int32Tree index{0};
-    // Per block id: its Size values (x-major, z fastest), the cells (0..7 per
-    // axis) whose trilinear stencil touches a non-zero value (lo in bits 0-11,
-    // hi exclusive in bits 12-23), and the largest and smallest value in its
-    // padded block: every trilinear value inside the cells lies between them,
-    // so they are a local majorant and a residual-tracking control.
-    std::vector<const float*> blockValues;
+    // Per id (a block's values, shared by every block of a constant value):
+    // the cells (0..7 per axis) whose trilinear stencil touches a non-zero
+    // value (lo in bits 0-11, hi exclusive in bits 12-23), and the largest and
+    // smallest value of the padded block: every trilinear value inside the
+    // cells lies between them, so they are a local majorant and a
+    // residual-tracking control. Tables per id, not per block: the constant
+    // blocks (a third of the 16x cloud's) add no entry.
     std::vector<uint32_t> tightBox;
     std::vector<float> blockMax, blockMin;
     // Bounding box of the dilated topology's active voxels (index space).
@@ -55,9 +63,13 @@ struct PaddedBlocks {
     };
     static Footprint predict(uint64_t gridBytes, uint64_t activeVoxels, const openvdb::CoordBBox& bounds);
 
-    const float* block(int32_t id) const { return blockValues[size_t(id - 1)]; }
-    size_t blockCount() const { return blockValues.size(); }
-    // Memory held: block values, per-block tables and the index tree.
+    // The Size values of index value `id` (> 0).
+    const float* block(int32_t id) const {
+        const size_t slot = size_t(id - 1);
+        return mChunks[slot / ChunkBlocks].get() + (slot % ChunkBlocks) * Size;
+    }
+    size_t blockCount() const { return tightBox.size(); }
+    // Memory held: block values, per-id tables and the index tree.
     uint64_t memoryBytes() const;
 
 private:
@@ -65,21 +77,21 @@ private:
     // values and tables and adds them to the index.
     void buildPiece(const openvdb::FloatGrid& grid, const openvdb::Coord* origins, size_t n,
                     std::vector<float>& scratch, openvdb::tree::ValueAccessor<openvdb::Int32Tree>& indexAccessor);
-    // The one block of `value` everywhere, shared by every block whose padded
-    // values all equal it (the inside of a constant region, an active tile).
-    float* constantBlock(float value);
-    // The next block's storage, in the current chunk.
-    float* allocateBlock();
+    // The id of the one block of `value` everywhere, shared by every block
+    // whose padded values all equal it (the inside of a constant region, an
+    // active tile), made on first use.
+    int32_t constantBlock(float value, uint32_t tightBox, float maximum, float minimum);
+    // A new id with its table entries; its values' storage is block(id).
+    int32_t allocateBlock(uint32_t tightBox, float maximum, float minimum);
 
-    struct FreeChunk {
-        void operator()(float* p) const { std::free(p); }
+    static float* mapChunk();
+    struct UnmapChunk {
+        void operator()(float* p) const;
     };
-    // Block values, carved in build order from large chunks, and the shared
-    // constant blocks by their value's bits.
-    std::vector<std::unique_ptr<float, FreeChunk>> mChunks;
-    size_t mChunkUsed = 0;
-    std::map<uint32_t, std::unique_ptr<float[]>> mConstantBlocks;
-    uint64_t mValueBytes = 0;
+    // Block values, carved in id order from the chunks, and the ids of the
+    // shared constant blocks by their value's bits.
+    std::vector<std::unique_ptr<float, UnmapChunk>> mChunks;
+    std::map<uint32_t, int32_t> mConstantBlocks;
 };
 
 }  // namespace vdbmarch
