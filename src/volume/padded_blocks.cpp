@@ -14,8 +14,10 @@
 #include <malloc.h>
 #endif
 
+#include <openvdb/tree/LeafManager.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace vdbmarch {
 
@@ -62,24 +64,41 @@ std::vector<NeighbourReach> neighbourReaches() {
 // block, without building the dilated tree.
 std::deque<Coord> dilatedBlockOrigins(const openvdb::FloatTree& tree, openvdb::CoordBBox& bounds) {
     static const std::vector<NeighbourReach> reaches = neighbourReaches();
-    openvdb::BoolTree blocks(false);
-    openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(blocks);
-    bounds = openvdb::CoordBBox();
-    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
-        const Coord b = leaf->origin() >> 3;
-        acc.setValueOn(b);
-        const auto& on = leaf->getValueMask();
-        if (on.isOff()) continue;
-        openvdb::CoordBBox box;
-        leaf->evalActiveBoundingBox(box, /*visitVoxels=*/true);
-        box.expand(1);
-        bounds.expand(box);
-        for (const NeighbourReach& n : reaches) {
-            LeafT::NodeMaskType hit = on;
-            hit &= n.voxels;
-            if (!hit.isOff()) acc.setValueOn(b + n.step);
+    // The leaves in parallel, each range into its own block set; the union of
+    // sets (and of boxes) does not depend on how the leaves were split.
+    struct MarkBlocks {
+        openvdb::BoolTree blocks{false};
+        openvdb::CoordBBox bounds;
+        MarkBlocks() = default;
+        MarkBlocks(MarkBlocks&, tbb::split) {}
+        void operator()(const openvdb::tree::LeafManager<const openvdb::FloatTree>::LeafRange& range) {
+            openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(blocks);
+            for (auto leaf = range.begin(); leaf; ++leaf) {
+                const Coord b = leaf->origin() >> 3;
+                acc.setValueOn(b);
+                const auto& on = leaf->getValueMask();
+                if (on.isOff()) continue;
+                openvdb::CoordBBox box;
+                leaf->evalActiveBoundingBox(box, /*visitVoxels=*/true);
+                box.expand(1);
+                bounds.expand(box);
+                for (const NeighbourReach& n : reaches) {
+                    LeafT::NodeMaskType hit = on;
+                    hit &= n.voxels;
+                    if (!hit.isOff()) acc.setValueOn(b + n.step);
+                }
+            }
         }
-    }
+        void join(MarkBlocks& other) {
+            blocks.topologyUnion(other.blocks);
+            bounds.expand(other.bounds);
+        }
+    } marked;
+    openvdb::tree::LeafManager<const openvdb::FloatTree> leaves(tree);
+    tbb::parallel_reduce(leaves.leafRange(64), marked);
+    openvdb::BoolTree& blocks = marked.blocks;
+    bounds = marked.bounds;
+    openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(blocks);
     // Active tiles: the interior nodes' values only (the leaves' voxels are
     // done). A tile's trilinear support reaches one voxel past each face: on
     // the high side that lies in the tile's own last blocks (a block holds
