@@ -225,7 +225,7 @@ void PaddedBlocks::buildPiece(const openvdb::FloatGrid& grid, const Coord* origi
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 64), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t b = r.begin(); b != r.end(); ++b)
             if (summaries[b].any && !summaries[b].constant)
-                std::memcpy(const_cast<float*>(block(ids[b])), &scratch[b * Size], Size * sizeof(float));
+                std::memcpy(values(ids[b]), &scratch[b * Size], Size * sizeof(float));
     });
     for (size_t b = 0; b < n; ++b) indexAccessor.addTile(1, origins[b], ids[b], true);
 }
@@ -342,9 +342,10 @@ float* PaddedBlocks::mapChunk() {
     if (p == MAP_FAILED) throw std::bad_alloc();
     const uintptr_t start = reinterpret_cast<uintptr_t>(p);
     const uintptr_t aligned = (start + HugePage - 1) & ~uintptr_t(HugePage - 1);
+    // Trim the mapping to [aligned, aligned + ChunkBytes): the head (empty when
+    // start is aligned) and the tail (never empty: aligned < start + HugePage).
     if (aligned > start) ::munmap(p, aligned - start);
-    if (aligned + ChunkBytes < start + ChunkBytes + HugePage)
-        ::munmap(reinterpret_cast<void*>(aligned + ChunkBytes), start + HugePage - aligned);
+    ::munmap(reinterpret_cast<void*>(aligned + ChunkBytes), start + HugePage - aligned);
 #if defined(MADV_HUGEPAGE)
     ::madvise(reinterpret_cast<void*>(aligned), ChunkBytes, MADV_HUGEPAGE);
 #endif
@@ -370,7 +371,7 @@ int32_t PaddedBlocks::constantBlock(float value, uint32_t box, float maximum, fl
     int32_t& id = mConstantBlocks[bits];
     if (id == 0) {
         id = allocateBlock(box, maximum, minimum);
-        std::fill_n(const_cast<float*>(block(id)), Size, value);
+        std::fill_n(values(id), Size, value);
     }
     return id;
 }

@@ -64,10 +64,7 @@ struct PaddedBlocks {
     static Footprint predict(uint64_t gridBytes, uint64_t activeVoxels, const openvdb::CoordBBox& bounds);
 
     // The Size values of index value `id` (> 0).
-    const float* block(int32_t id) const {
-        const size_t slot = size_t(id - 1);
-        return mChunks[slot / ChunkBlocks].get() + (slot % ChunkBlocks) * Size;
-    }
+    const float* block(int32_t id) const { return values(id); }
     size_t blockCount() const { return tightBox.size(); }
     // Memory held: block values, per-id tables and the index tree.
     uint64_t memoryBytes() const;
@@ -84,6 +81,11 @@ private:
     // A new id with its table entries; its values' storage is block(id).
     int32_t allocateBlock(uint32_t tightBox, float maximum, float minimum);
 
+    // The storage of id's values (the build writes them; lookups read them).
+    float* values(int32_t id) const {
+        const size_t slot = size_t(id - 1);
+        return mChunks[slot / ChunkBlocks].get() + (slot % ChunkBlocks) * Size;
+    }
     static float* mapChunk();
     struct UnmapChunk {
         void operator()(float* p) const;
