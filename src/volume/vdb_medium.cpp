@@ -389,12 +389,17 @@ void VdbQuery::walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit) {
     double tNode = t0;
     while (tNode < t1) {
         const double nodeExit = std::min(outer.tNext[outer.axis()], t1);
-        if (mBlockIndex.probeConstNode<IndexNode>(openvdb::Coord(outer.cell[0], outer.cell[1], outer.cell[2]))) {
+        if (const IndexNode* node =
+                mBlockIndex.probeConstNode<IndexNode>(openvdb::Coord(outer.cell[0], outer.cell[1], outer.cell[2]))) {
+            // Every entry of an index node is a tile (padded_blocks.h): its
+            // value is read from the node's table, with no tree descent.
+            const auto* table = node->getTable();
             inner.init(eye, dir, inv, tNode, nodeExit, 8);
             double tCur = tNode;
             while (tCur < nodeExit) {
                 const double tExit = std::min(inner.tNext[inner.axis()], nodeExit);
-                const int32_t id = mBlockIndex.getValue(openvdb::Coord(inner.cell[0], inner.cell[1], inner.cell[2]));
+                const openvdb::Index n = IndexNode::coordToOffset(openvdb::Coord(inner.cell[0], inner.cell[1], inner.cell[2]));
+                const int32_t id = table[n].getValue();
                 if (id > 0) {
                     const uint32_t box = mMedium.mBlocks.tightBox[size_t(id - 1)];
                     double a = tCur, b = tExit;
