@@ -403,7 +403,9 @@ void VdbQuery::walkBlocks(const Ray& r, float tMin, float tMax, Visit&& visit) {
                 if (id > 0) {
                     const uint32_t box = mMedium.mBlocks.tightBox[size_t(id - 1)];
                     double a = tCur, b = tExit;
-                    for (int ax = 0; ax < 3 && a < b; ++ax) {
+                    // A box of all 8^3 cells (most blocks inside a cloud) clips nothing.
+                    constexpr uint32_t AllCells = 0x888000;
+                    for (int ax = 0; ax < 3 && a < b && box != AllCells; ++ax) {
                         double lo = inner.cell[ax] + double((box >> (4 * ax)) & 15);
                         double hi = inner.cell[ax] + double((box >> (12 + 4 * ax)) & 15);
                         double ta = (lo - eye[ax]) * inv[ax], tb = (hi - eye[ax]) * inv[ax];
