@@ -33,6 +33,10 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
         if (!m->isVacuum() || m->hasEmission) {
             scene->regions[2 + i].media.push_back(int(i));
             if (!isInterior[i]) scene->regions[Scene::WorldRegion].media.push_back(int(i));
+            if (md.type == MediumDesc::Type::Vdb) {
+                scene->regions[2 + i].gridded = true;
+                if (!isInterior[i]) scene->regions[Scene::WorldRegion].gridded = true;
+            }
             if (md.type == MediumDesc::Type::Homogeneous && !md.hasBounds) {
                 Color k = min(md.sigma_a + md.sigma_s, Color(1e30f));
                 scene->regions[2 + i].unboundedSigmaT += k;

@@ -19,6 +19,7 @@ namespace vdbmarch {
 struct Region {
     std::vector<int> media;
     Color unboundedSigmaT{0, 0, 0};  // summed extinction of its unbounded homogeneous media
+    bool gridded = false;            // holds a VDB medium (its rays march a grid)
 };
 
 struct SurfaceInfo {

@@ -27,6 +27,25 @@ float ScatterVertex::fPdf(const Vec3& wi) const {
     return std::max(0.f, dot(wi, nf)) * InvPi;
 }
 
+namespace {
+
+// Shadow-ray roulette on the phase value f (DirectLightOptions::phaseRoulette):
+// false when the sample is dropped; else the factor its survivor counts.
+bool phaseRoulette(const Scene& scene, int region, const ScatterVertex& v, const Color& f,
+                   const DirectLightOptions& o, Rng& rng, float& factor) {
+    factor = 1;
+    if (!o.phaseRoulette || !v.phase || !scene.regions[size_t(region)].gridded) return true;
+    const float level = PhaseRouletteShare * v.phase->meanPhaseValue();  // in units of 1 / (4 pi)
+    if (!(level > 1)) return true;
+    const float q = average(f) * (4 * Pi) / level;
+    if (!(q < 1)) return true;
+    if (!(q > 0) || rng.uniform() >= q) return false;
+    factor = 1 / q;
+    return true;
+}
+
+}  // namespace
+
 Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng, const DirectLightOptions& o) {
     const Scene& scene = ctx.scene;
     Color L(0);
@@ -45,9 +64,11 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;
         const Color f = v.f(ls.wi);
-        if (isBlack(f)) continue;
+        float survivor;
+        if (isBlack(f) || !phaseRoulette(scene, region, v, f, o, rng, survivor)) continue;
         const float w = o.misWithPathHits && light.isSphere() ? powerHeuristic(ls.pdf, v.pdf(ls.wi)) : 1.f;
-        L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) * (w * lightWeight);
+        L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) *
+             (w * lightWeight * survivor);
     }
     if (o.onlyLight >= 0) return L;
     const Environment& env = scene.environment;
@@ -63,8 +84,9 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (env.sample(u1, u2, wi, pdf, radianceOverPdf)) {
             const Color f = v.f(wi);
-            if (!isBlack(f)) {
-                const float w = powerHeuristic(pdf, o.misWithPathHits ? v.pdf(wi) : v.fPdf(wi));
+            float survivor;
+            if (!isBlack(f) && phaseRoulette(scene, region, v, f, o, rng, survivor)) {
+                const float w = powerHeuristic(pdf, o.misWithPathHits ? v.pdf(wi) : v.fPdf(wi)) * survivor;
                 L += f * radianceOverPdf * (w * shadowTransmittance(ctx, region, origin, wi, Infinity, rng, o.transmittance));
             }
         }

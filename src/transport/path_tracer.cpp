@@ -20,7 +20,9 @@ namespace {
 // sphere lights are also hit by the path, a constant background only by the
 // path, an environment map by both.
 DirectLightOptions nextEventOptions(const PathState& st, const float* lightWeights = nullptr) {
-    return {TransmittanceEstimator::UnbiasedMarching, true, false, st.pointLightsByPhotons, lightWeights};
+    DirectLightOptions o{TransmittanceEstimator::UnbiasedMarching, true, false, st.pointLightsByPhotons, lightWeights};
+    o.phaseRoulette = true;
+    return o;
 }
 
 // Russian roulette on the throughput after RouletteMinDepth events.

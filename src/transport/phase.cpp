@@ -52,6 +52,21 @@ void PhaseMixture::legendreWeights(int order, float* out) const {
     }
 }
 
+float PhaseMixture::meanPhaseValue() const {
+    auto lobe = [](double gi) {
+        const double g2 = gi * gi;
+        return (1 + g2) / ((1 - g2) * (1 - g2));
+    };
+    if (count == 1) return float(lobe(g[0]));
+    double total = 0, m = 0;
+    for (int i = 0; i < count; ++i) {
+        const double w = average(sigmaS[i]);
+        total += w;
+        m += w * lobe(g[i]);
+    }
+    return total > 0 ? float(m / total) : 1.f;
+}
+
 bool PhaseMixture::isotropic() const {
     for (int i = 0; i < count; ++i)
         if (g[i] != 0) return false;

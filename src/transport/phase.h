@@ -40,6 +40,12 @@ struct PhaseMixture {
     void legendreWeights(int order, float* out) const;
     // True when every lobe has g = 0 (the mixture is isotropic).
     bool isotropic() const;
+    // The phase value a direction drawn from the phase itself has on
+    // average, int f^2 dOmega, in units of the isotropic 1 / (4 pi): for one
+    // Henyey-Greenstein lobe (1 + g^2) / (1 - g^2)^2 (1 for g = 0, 12.7 for
+    // g = 0.8); for a mixture the lobes' values weighed as in pdf() (a
+    // scale for shadow-ray roulette, not an exact moment).
+    float meanPhaseValue() const;
 };
 
 }  // namespace vdbmarch

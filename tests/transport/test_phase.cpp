@@ -51,6 +51,20 @@ TEST(PhaseMixture, EvalAndPdfIntegrateToOne) {
     EXPECT_NEAR(sphereIntegral([&](double u) { return double(m.pdf(float(u))); }), 1.0, 1e-4);
 }
 
+// The closed form of int f^2 dOmega (shadow-ray roulette's scale) against
+// quadrature, in units of the isotropic 1 / (4 pi).
+TEST(PhaseMixture, MeanPhaseValueIsTheIntegralOfTheSquare) {
+    for (float g : {0.f, 0.3f, 0.8f, -0.9f}) {
+        PhaseMixture m;
+        m.add(Color(1.f), g);
+        const double q = 4 * PiD * sphereIntegral([&](double u) {
+            const double f = hgPhase(float(u), g);
+            return f * f;
+        });
+        EXPECT_NEAR(m.meanPhaseValue(), q, 1e-3 * q) << "g " << g;
+    }
+}
+
 TEST(PhaseMixture, SingleMediumIsItsHenyeyGreensteinLobe) {
     PhaseMixture m;
     m.add(Color(2.f), 0.6f);
