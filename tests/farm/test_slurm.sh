@@ -48,7 +48,16 @@ RENDER_OPTS=(--res 96x72 --spp 4 --seed 7)
 
 step "bringing up the loopback cluster in $STATE"
 t_up=$EPOCHREALTIME
-eval "$(bash "$ROOT/tools/farm/slurm_local.sh" up "$STATE")"
+# `eval "$(... up)"` would swallow a failed bring-up (the substitution's
+# status is lost) and die later on an unset SLURM_CONF: name the failure.
+# One retry: the loopback daemons occasionally lose a start-up race.
+bring_up() { bash "$ROOT/tools/farm/slurm_local.sh" up "$STATE"; }
+if ! cluster_env=$(bring_up); then
+  echo "test_slurm: the loopback cluster did not come up; retrying once"
+  bash "$ROOT/tools/farm/slurm_local.sh" down "$STATE" || true
+  cluster_env=$(bring_up) || { echo "test_slurm: FAIL: tools/farm/slurm_local.sh up $STATE failed twice"; exit 1; }
+fi
+eval "$cluster_env"
 step "cluster up in $(awk -v a="$t_up" -v b="$EPOCHREALTIME" 'BEGIN{printf "%.1f", b-a}') s: SLURM_CONF=$SLURM_CONF"
 sinfo
 
