@@ -166,19 +166,27 @@ BlockSummary summarize(const float* v) {
     bool constant = true;
     for (int x = 0; x < N; ++x)
         for (int y = 0; y < N; ++y) {
+            // Per row: its extremes and the first and last non-zero z; the
+            // row's x and y join the box once, if any value is non-zero.
             const float* row = v + (x * N + y) * N;
+            int zLo = N, zHi = -1;
             for (int z = 0; z < N; ++z) {
                 const float value = row[z];
                 mn = std::min(mn, value);
                 mx = std::max(mx, value);
                 constant = constant && value == v[0];
-                if (value == 0) continue;
-                const int p[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a) {
-                    lo[a] = std::min(lo[a], p[a]);
-                    hi[a] = std::max(hi[a], p[a]);
+                if (value != 0) {
+                    zLo = std::min(zLo, z);
+                    zHi = z;
                 }
             }
+            if (zHi < 0) continue;
+            lo[0] = std::min(lo[0], x);
+            hi[0] = std::max(hi[0], x);
+            lo[1] = std::min(lo[1], y);
+            hi[1] = std::max(hi[1], y);
+            lo[2] = std::min(lo[2], zLo);
+            hi[2] = std::max(hi[2], zHi);
         }
     b.any = hi[0] >= 0;
     b.constant = b.any && constant;
