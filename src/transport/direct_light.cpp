@@ -29,25 +29,29 @@ float ScatterVertex::fPdf(const Vec3& wi) const {
 
 namespace {
 
-// Shadow-ray roulette on the phase value f (DirectLightOptions::phaseRoulette):
-// false when the sample is dropped; else the factor its survivor counts.
-bool phaseRoulette(const Scene& scene, int region, const ScatterVertex& v, const Color& f,
-                   const DirectLightOptions& o, Rng& rng, float& factor) {
-    factor = 1;
-    if (!o.phaseRoulette || !v.phase || !scene.regions[size_t(region)].gridded) return true;
-    const float level = PhaseRouletteShare * v.phase->meanPhaseValue();  // in units of 1 / (4 pi)
-    if (!(level > 1)) return true;
+// The level of shadow-ray roulette by the phase value at vertex v, in units
+// of the isotropic 1 / (4 pi) (DirectLightOptions::phaseRoulette); 0 where
+// nothing is rouletted.
+float phaseRouletteLevel(const Scene& scene, int region, const ScatterVertex& v, const DirectLightOptions& o) {
+    if (!o.phaseRoulette || !v.phase || !scene.regions[size_t(region)].gridded) return 0.f;
+    const float level = PhaseRouletteShare * v.phase->meanPhaseValue();
+    return level > 1 ? level : 0.f;
+}
+
+// What a light sample of phase value f counts: 1 at or above the level,
+// else 1 / q with probability q = f / level and 0 (no shadow ray) otherwise.
+float phaseRouletteWeight(float level, const Color& f, Rng& rng) {
+    if (!(level > 0)) return 1.f;
     const float q = average(f) * (4 * Pi) / level;
-    if (!(q < 1)) return true;
-    if (!(q > 0) || rng.uniform() >= q) return false;
-    factor = 1 / q;
-    return true;
+    if (!(q < 1)) return 1.f;
+    return q > 0 && rng.uniform() < q ? 1 / q : 0.f;
 }
 
 }  // namespace
 
 Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng, const DirectLightOptions& o) {
     const Scene& scene = ctx.scene;
+    const float rouletteLevel = phaseRouletteLevel(scene, region, v, o);
     Color L(0);
     Vec3 origin = v.p, nf;
     if (!v.phase) {  // leave the surface on the side the path arrived from
@@ -64,8 +68,9 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (!light.sample(origin, u1, u2, ls) || isBlack(ls.L)) continue;
         const Color f = v.f(ls.wi);
-        float survivor;
-        if (isBlack(f) || !phaseRoulette(scene, region, v, f, o, rng, survivor)) continue;
+        if (isBlack(f)) continue;
+        const float survivor = phaseRouletteWeight(rouletteLevel, f, rng);
+        if (!(survivor > 0)) continue;
         const float w = o.misWithPathHits && light.isSphere() ? powerHeuristic(ls.pdf, v.pdf(ls.wi)) : 1.f;
         L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) *
              (w * lightWeight * survivor);
@@ -84,8 +89,8 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         const float u1 = rng.uniform(), u2 = rng.uniform();
         if (env.sample(u1, u2, wi, pdf, radianceOverPdf)) {
             const Color f = v.f(wi);
-            float survivor;
-            if (!isBlack(f) && phaseRoulette(scene, region, v, f, o, rng, survivor)) {
+            const float survivor = isBlack(f) ? 0.f : phaseRouletteWeight(rouletteLevel, f, rng);
+            if (survivor > 0) {
                 const float w = powerHeuristic(pdf, o.misWithPathHits ? v.pdf(wi) : v.fPdf(wi)) * survivor;
                 L += f * radianceOverPdf * (w * shadowTransmittance(ctx, region, origin, wi, Infinity, rng, o.transmittance));
             }
