@@ -49,6 +49,12 @@ struct DenoiseOptions {
     // before filtering: a firefly in one half would otherwise spread over a
     // search window.
     bool suppressFireflies = true;
+    // The denoised image keeps the noisy image's local means: the Gaussian
+    // average (this standard deviation, in pixels) of what filtering and the
+    // firefly clamp changed is added back, so the denoiser adds no bias at
+    // larger scales and a clamped firefly's light stays, spread over about
+    // this radius. 0: off.
+    float restoreSigma = 4.f;
     float featureStrength = 0.6f;
     float featureThreshold = 1e-3f;
     // The features are first denoised by NL-means guided by themselves

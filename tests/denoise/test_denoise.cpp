@@ -13,6 +13,7 @@
 
 #include "core/rng.h"
 #include "denoise/denoise.h"
+#include "image/metrics.h"
 
 namespace vdbmarch {
 namespace {
@@ -296,6 +297,8 @@ TEST(DenoiseRobustness, SizeMismatchesAndBadOptionsThrow) {
     throws([](DenoiseInput&, DenoiseOptions& o) { o.searchRadius = -1; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.colorStrength = 0; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.threads = -2; });
+    throws([](DenoiseInput&, DenoiseOptions& o) { o.restoreSigma = -1; });
+    throws([](DenoiseInput&, DenoiseOptions& o) { o.restoreSigma = std::numeric_limits<float>::quiet_NaN(); });
 
     // Absent optional inputs are fine: an opaque, colour-only denoise.
     DenoiseInput bare;
@@ -327,32 +330,116 @@ TEST(DenoiseQuality, TheImageMeanIsNearlyUnchanged) {
     EXPECT_LT(relativeChange, 2 * standardError / meanRgb(noisy));
 }
 
+// Sparse bright detail (soft bumps of 0.7-2.2 pixels on a dim ground, as the
+// fine structure of a cloud) under noise that grows with the value, as Monte
+// Carlo noise does: NL-means averages bright pixels with dim ones whose
+// patches look alike, and without restoring the local means the denoised
+// image's low-frequency error (8x8 block means, issue 21's bias measure)
+// exceeds the noisy image's (1.17-1.28x over seeds 1-5, as cloud_sun's
+// 1.22-1.27x). Restored: 0.95-1.0x; the issue's bound is 1.1x.
+TEST(DenoiseQuality, SparseBrightDetailKeepsItsLowFrequencies) {
+    const int w = 160, h = 120;
+    Rng rng(11);
+    Image truth(w, h);
+    DenoiseInput in;
+    in.width = w;
+    in.height = h;
+    std::vector<float> field(size_t(w) * h, 0.05f);
+    for (int k = 0; k < w * h / 40; ++k) {
+        const float cx = rng.uniform() * w, cy = rng.uniform() * h, r = 0.7f + 1.5f * rng.uniform();
+        for (int y = std::max(0, int(cy - 3 * r)); y < std::min(h, int(cy + 3 * r) + 1); ++y)
+            for (int x = std::max(0, int(cx - 3 * r)); x < std::min(w, int(cx + 3 * r) + 1); ++x)
+                field[size_t(y) * w + x] += std::exp(-0.5f * (std::pow(x + 0.5f - cx, 2.f) + std::pow(y + 0.5f - cy, 2.f)) / (r * r));
+    }
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float t = field[size_t(y) * w + x];
+            truth.set(x, y, Color(t), 1.f);
+            const float sigma = 0.3f * std::sqrt(t);
+            in.halfA.push_back(Color(t) + sigma * Color(gaussian(rng), gaussian(rng), gaussian(rng)));
+            in.halfB.push_back(Color(t) + sigma * Color(gaussian(rng), gaussian(rng), gaussian(rng)));
+        }
+    DenoiseOptions restored, notRestored;
+    notRestored.restoreSigma = 0;
+    const double noisy = lowFrequencyError(noisyMean(in), truth);
+    const double with = lowFrequencyError(denoise(in, restored), truth);
+    const double without = lowFrequencyError(denoise(in, notRestored), truth);
+    std::printf("[ denoise ] sparse detail, low-frequency error: noisy %.4f, denoised %.4f, not restored %.4f\n", noisy,
+                with, without);
+    EXPECT_LE(with, 1.1 * noisy);
+    EXPECT_GT(without, 1.1 * noisy);
+}
+
 // A firefly (one sample 1000x the level, in one half only) in a noisy flat
-// frame: with the clamp it stays one pixel's worth of error; without it,
-// cross-filtering spreads it over the search window (a square blotch).
-TEST(DenoiseRobustness, AFireflyDoesNotSpreadIntoABlotch) {
-    const int w = 64, h = 48;
+// frame. Without the clamp, cross-filtering spreads it over the search window
+// (a square blotch). With it, the firefly's light is neither lost (the local
+// means are restored) nor spread beyond the restoring Gaussian: it stays a
+// round glow of about restoreSigma pixels.
+TEST(DenoiseRobustness, AFireflysLightIsKeptAndStaysRoundItsPixel) {
+    const int w = 64, h = 48, fx = 32, fy = 24;
+    const float level = 0.5f, firefly = 500.f;
     Rng rng(5);
     DenoiseInput in;
     in.width = w;
     in.height = h;
     for (int i = 0; i < w * h; ++i) {
-        in.halfA.push_back(Color(0.5f) + 0.05f * Color(gaussian(rng)));
-        in.halfB.push_back(Color(0.5f) + 0.05f * Color(gaussian(rng)));
+        in.halfA.push_back(Color(level) + 0.05f * Color(gaussian(rng)));
+        in.halfB.push_back(Color(level) + 0.05f * Color(gaussian(rng)));
     }
-    in.halfA[size_t(24 * w + 32)] = Color(500.f);
-    auto blotch = [&](bool suppress) {
-        DenoiseOptions o;
-        o.suppressFireflies = suppress;
-        const Image d = denoise(in, o);
+    in.halfA[size_t(fy * w + fx)] = Color(firefly);
+    // The firefly's light in the output: what lies above the level, within
+    // `radius` of the firefly (in the red channel), and the farthest pixel
+    // more than 0.1 above the level (2 noise sigmas of a half).
+    struct Light {
+        double near = 0, all = 0;
+        double farthestBright = 0;
         int bright = 0;
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) bright += d.rgb(x, y).x > 0.6f;  // 0.1 above the level: 2 noise sigmas of a half
-        return bright;
     };
-    const int with = blotch(true), without = blotch(false);
-    EXPECT_LE(with, 1);
-    EXPECT_GE(without, 50);  // measured: the search window's hundreds of pixels
+    auto light = [&](const DenoiseOptions& o, double radius) {
+        const Image d = denoise(in, o);
+        Light l;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const double above = double(d.rgb(x, y).x) - level, r = std::hypot(x - fx, y - fy);
+                l.all += above;
+                if (r <= radius) l.near += above;
+                if (above > 0.1) {
+                    ++l.bright;
+                    l.farthestBright = std::max(l.farthestBright, r);
+                }
+            }
+        return l;
+    };
+    DenoiseOptions kept;
+    const double sigma = kept.restoreSigma;
+    // The firefly's own light in the noisy image (the mean of the halves).
+    const double energy = (firefly - level) / 2;
+    const Light with = light(kept, sigma), withTwo = light(kept, 2 * sigma);
+    DenoiseOptions unclamped;
+    unclamped.suppressFireflies = false;
+    unclamped.restoreSigma = 0;
+    const Light without = light(unclamped, sigma);
+    DenoiseOptions lost;
+    lost.restoreSigma = 0;
+    const Light clampedOnly = light(lost, sigma);
+    std::printf("[ denoise ] firefly light %.1f: kept %.1f (%.1f within sigma, %.1f within 2 sigma, %d bright, "
+                "farthest %.1f px); unclamped %.1f (%.1f within sigma, %d bright); clamped, not restored %.1f\n",
+                energy, with.all, with.near, withTwo.near, with.bright, with.farthestBright, without.all, without.near,
+                without.bright, clampedOnly.all);
+    // Kept: the whole light (the flat frame's noise adds about 0.05 / sqrt(2)
+    // x sqrt(64 x 48) = 2 to the sum), as a Gaussian round the pixel (39 %
+    // of it within sigma, 86 % within 2 sigma) with nothing bright beyond
+    // its 3 sigma cut.
+    EXPECT_NEAR(with.all, energy, 0.02 * energy);
+    EXPECT_GT(with.near, 0.33 * energy);
+    EXPECT_GT(withTwo.near, 0.8 * energy);
+    EXPECT_LE(with.farthestBright, std::ceil(3 * sigma) * std::sqrt(2.0));
+    // Without the clamp: a flat blotch over the search window (19 x 19
+    // pixels), so far less of the light lies within sigma; with the clamp
+    // alone (no restoring), the light is lost.
+    EXPECT_GE(without.bright, 300);
+    EXPECT_LT(without.near, 0.25 * without.all);
+    EXPECT_LT(clampedOnly.all, 0.1 * energy);
 }
 
 }  // namespace
