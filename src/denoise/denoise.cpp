@@ -142,6 +142,50 @@ Plane gaussianAverage(const Plane& in, float sigma) {
     return out;
 }
 
+// Spreads each pixel's value over a Gaussian of standard deviation `sigma`
+// pixels (cut at 3 sigma), its weights normalised over the pixels inside the
+// image that it reaches (separable): the sum over the image is kept, where
+// gaussianAverage keeps a constant.
+Plane gaussianSpread(const Plane& in, float sigma) {
+    const int w = in.width, h = in.height, radius = int(std::ceil(3.f * sigma));
+    std::vector<float> kernel(size_t(2 * radius + 1));
+    for (int i = -radius; i <= radius; ++i)
+        kernel[size_t(i + radius)] = std::exp(-0.5f * float(i * i) / (sigma * sigma));
+    // 1 / (the weights a source at i gives to the pixels inside [0, size)).
+    auto inverseReach = [&](int size) {
+        std::vector<float> inverse(static_cast<size_t>(size));
+        for (int i = 0; i < size; ++i) {
+            float sum = 0;
+            for (int p = std::max(0, i - radius); p <= std::min(size - 1, i + radius); ++p)
+                sum += kernel[size_t(p - i + radius)];
+            inverse[size_t(i)] = 1.f / sum;
+        }
+        return inverse;
+    };
+    const std::vector<float> inverseX = inverseReach(w), inverseY = inverseReach(h);
+    Plane horizontal(w, h, in.pad), out(w, h, in.pad);
+    forEachRow(h, [&](int y) {
+        const float* src = in.row(y);
+        float* dst = horizontal.row(y);
+        for (int x = 0; x < w; ++x) {
+            float sum = 0;
+            for (int i = std::max(0, x - radius); i <= std::min(w - 1, x + radius); ++i)
+                sum += kernel[size_t(i - x + radius)] * src[i] * inverseX[size_t(i)];
+            dst[x] = sum;
+        }
+    });
+    forEachRow(h, [&](int y) {
+        float* dst = out.row(y);
+        for (int x = 0; x < w; ++x) dst[x] = 0;
+        for (int j = std::max(0, y - radius); j <= std::min(h - 1, y + radius); ++j) {
+            const float k = kernel[size_t(j - y + radius)] * inverseY[size_t(j)];
+            const float* src = horizontal.row(j);
+            for (int x = 0; x < w; ++x) dst[x] += k * src[x];
+        }
+    });
+    return out;
+}
+
 // Distances are clamped to [0, 87] before expMinus: a negative distance
 // (two values closer than their noise) weighs 1, and e^-87 < 2e-38 is as good
 // as 0. A loop of its own, since a clamp in the loop of the exponential keeps
@@ -398,10 +442,10 @@ std::vector<float> channelOf(const std::vector<Color>& v, int c) {
 // neighbour (a square blotch), since the other half's patches look normal
 // there. A real feature shows in both halves, so each half is clamped to
 // twice the other half's 3x3 maximum plus the other half's image mean (the
-// floor for dark surroundings) before filtering. What the clamp takes is not
-// lost: the local means are restored after filtering (denoise() below), so
-// a firefly's light stays as a small Gaussian around its pixel.
-void suppressFireflies(Plane& a, Plane& b) {
+// floor for dark surroundings) before filtering. Returns what the clamp took
+// (the mean of the two halves' excess): denoise() spreads it back as a
+// faint glow after filtering, so no light is lost.
+Plane suppressFireflies(Plane& a, Plane& b) {
     const int w = a.width, h = a.height;
     auto mean = [&](const Plane& p) {
         double sum = 0;  // serial: the same sum for any thread count
@@ -423,14 +467,18 @@ void suppressFireflies(Plane& a, Plane& b) {
         return bound;
     };
     const Plane boundA = bounds(b, meanB), boundB = bounds(a, meanA);
+    Plane excess(w, h, 0);
     forEachRow(h, [&](int y) {
         for (int x = 0; x < w; ++x) {
-            a.at(x, y) = std::min(a.at(x, y), boundA.at(x, y));
-            b.at(x, y) = std::min(b.at(x, y), boundB.at(x, y));
+            const float ca = std::min(a.at(x, y), boundA.at(x, y)), cb = std::min(b.at(x, y), boundB.at(x, y));
+            excess.at(x, y) = 0.5f * ((a.at(x, y) - ca) + (b.at(x, y) - cb));
+            a.at(x, y) = ca;
+            b.at(x, y) = cb;
         }
     });
     a.replicateEdges();
     b.replicateEdges();
+    return excess;
 }
 
 Plane halfVariance(const Plane& a, const Plane& b, int radius) {
@@ -694,8 +742,11 @@ void checkOptions(const DenoiseOptions& o) {
     positive(o.featureStrength, "featureStrength");
     positive(o.featureThreshold, "featureThreshold");
     positive(o.featurePrefilterStrength, "featurePrefilterStrength");
-    if (!(o.restoreSigma >= 0 && o.restoreSigma <= 32))
-        throw std::invalid_argument(str("denoise: restoreSigma ", o.restoreSigma, " is outside [0, 32]"));
+    auto sigma = [](float v, const char* name) {
+        if (!(v >= 0 && v <= 32)) throw std::invalid_argument(str("denoise: ", name, " ", v, " is outside [0, 32]"));
+    };
+    sigma(o.restoreSigma, "restoreSigma");
+    sigma(o.fireflySigma, "fireflySigma");
 }
 
 }  // namespace
@@ -725,17 +776,19 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
         // Colour and alpha of both halves, and the variance of one half.
         const int channels = hasAlpha ? 4 : 3;
         const size_t planes = static_cast<size_t>(channels);
-        // `noisy`: the colour's mean of the two halves before any clamp.
-        std::vector<Plane> a(planes), b(planes), variance(planes), noisy(3);
+        // `clamped`: the colour's mean of the two halves after the firefly
+        // clamp; `clampedLight`: what the clamp took (the mean of the two
+        // halves' excess).
+        std::vector<Plane> a(planes), b(planes), variance(planes), clamped(3), clampedLight(3);
         for (int c = 0; c < channels; ++c) {
             if (c < 3) {
-                loadHalves(channelOf(in.halfA, c), channelOf(in.halfB, c), w, h, pad, a[size_t(c)], b[size_t(c)]);
-                noisy[size_t(c)] = Plane(w, h, 0);
+                const size_t k = size_t(c);
+                loadHalves(channelOf(in.halfA, c), channelOf(in.halfB, c), w, h, pad, a[k], b[k]);
+                if (options.suppressFireflies) clampedLight[k] = suppressFireflies(a[k], b[k]);
+                clamped[k] = Plane(w, h, 0);
                 forEachRow(h, [&](int y) {
-                    for (int x = 0; x < w; ++x)
-                        noisy[size_t(c)].at(x, y) = 0.5f * (a[size_t(c)].at(x, y) + b[size_t(c)].at(x, y));
+                    for (int x = 0; x < w; ++x) clamped[k].at(x, y) = 0.5f * (a[k].at(x, y) + b[k].at(x, y));
                 });
-                if (options.suppressFireflies) suppressFireflies(a[size_t(c)], b[size_t(c)]);
             } else
                 loadHalves(in.alphaA, in.alphaB, w, h, pad, a[3], b[3]);
             variance[size_t(c)] = halfVariance(a[size_t(c)], b[size_t(c)], options.varianceRadius);
@@ -856,21 +909,30 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
         // pixel with similar ones wherever they are in the search window,
         // which moves light between bright and dim structure (on cloud_sun a
         // darkening of 0.4 % and errors at scales of 8 to 32 pixels twice the
-        // noisy image's), and the firefly clamp takes light. The Gaussian
-        // average of (noisy - filtered) is added back: only detail finer
-        // than the Gaussian is the filter's, and the image keeps its energy.
-        if (options.restoreSigma > 0)
-            for (int c = 0; c < 3; ++c) {
+        // noisy image's). The Gaussian average of (clamped - filtered) is
+        // added back: only detail finer than the Gaussian is the filter's.
+        // The light the firefly clamp took is added back too, spread by a
+        // wider Gaussian (a faint glow, not a blob): the image keeps its
+        // energy.
+        for (int c = 0; c < 3; ++c) {
+            const size_t k = size_t(c);
+            if (options.restoreSigma > 0) {
                 Plane change(w, h, 0);
                 forEachRow(h, [&](int y) {
-                    for (int x = 0; x < w; ++x)
-                        change.at(x, y) = noisy[size_t(c)].at(x, y) - filtered[size_t(c)].at(x, y);
+                    for (int x = 0; x < w; ++x) change.at(x, y) = clamped[k].at(x, y) - filtered[k].at(x, y);
                 });
                 const Plane restored = gaussianAverage(change, options.restoreSigma);
                 forEachRow(h, [&](int y) {
-                    for (int x = 0; x < w; ++x) filtered[size_t(c)].at(x, y) += restored.at(x, y);
+                    for (int x = 0; x < w; ++x) filtered[k].at(x, y) += restored.at(x, y);
                 });
             }
+            if (options.suppressFireflies && options.fireflySigma > 0) {
+                const Plane spread = gaussianSpread(clampedLight[k], options.fireflySigma);
+                forEachRow(h, [&](int y) {
+                    for (int x = 0; x < w; ++x) filtered[k].at(x, y) += spread.at(x, y);
+                });
+            }
+        }
         forEachRow(h, [&](int y) {
             for (int x = 0; x < w; ++x) {
                 float value[4] = {0, 0, 0, 1};

@@ -50,11 +50,13 @@ struct DenoiseOptions {
     // search window.
     bool suppressFireflies = true;
     // The denoised image keeps the noisy image's local means: the Gaussian
-    // average (this standard deviation, in pixels) of what filtering and the
-    // firefly clamp changed is added back, so the denoiser adds no bias at
-    // larger scales and a clamped firefly's light stays, spread over about
-    // this radius. 0: off.
+    // average (this standard deviation, in pixels) of what filtering changed
+    // is added back, so the denoiser adds no bias at larger scales. 0: off.
     float restoreSigma = 4.f;
+    // What the firefly clamp took is added back spread by a Gaussian of this
+    // standard deviation (pixels): a faint glow, and no light lost. 0: the
+    // clamp's light is dropped (biased).
+    float fireflySigma = 8.f;
     float featureStrength = 0.6f;
     float featureThreshold = 1e-3f;
     // The features are first denoised by NL-means guided by themselves

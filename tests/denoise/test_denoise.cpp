@@ -250,7 +250,10 @@ TEST(DenoiseRobustness, NonFiniteInputsGiveAFiniteOutput) {
     in.halfB[at(11, 10)] = Color(-inf);
     in.halfA[at(20, 20)] = in.halfB[at(20, 20)] = Color(nan);  // missing in both halves
     in.halfA[at(0, 0)] = in.halfB[at(0, 0)] = Color(inf);
-    in.halfA[at(30, 5)] = Color(1e30f);  // finite but absurd
+    // Finite but absurd: clamped as a firefly, its light comes back as a
+    // glow of 3 fireflySigma = 24 pixels, so it sits farther than that from
+    // the pixel checked below.
+    in.halfA[at(60, 46)] = Color(1e30f);
     in.alphaA[at(5, 40)] = nan;
     in.alphaB[at(6, 40)] = -inf;
     in.albedo[at(40, 30)] = Color(nan);
@@ -299,6 +302,7 @@ TEST(DenoiseRobustness, SizeMismatchesAndBadOptionsThrow) {
     throws([](DenoiseInput&, DenoiseOptions& o) { o.threads = -2; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.restoreSigma = -1; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.restoreSigma = std::numeric_limits<float>::quiet_NaN(); });
+    throws([](DenoiseInput&, DenoiseOptions& o) { o.fireflySigma = 33; });
 
     // Absent optional inputs are fine: an opaque, colour-only denoise.
     DenoiseInput bare;
@@ -372,10 +376,10 @@ TEST(DenoiseQuality, SparseBrightDetailKeepsItsLowFrequencies) {
 
 // A firefly (one sample 1000x the level, in one half only) in a noisy flat
 // frame. Without the clamp, cross-filtering spreads it over the search window
-// (a square blotch). With it, the firefly's light is neither lost (the local
-// means are restored) nor spread beyond the restoring Gaussian: it stays a
-// round glow of about restoreSigma pixels.
-TEST(DenoiseRobustness, AFireflysLightIsKeptAndStaysRoundItsPixel) {
+// of every neighbour (a square blotch of 19 x 19 pixels). With it, the
+// firefly's light is neither lost nor left as a blotch: it comes back as the
+// Gaussian glow of fireflySigma that the design prescribes.
+TEST(DenoiseRobustness, AFireflysLightComesBackAsAFaintGlow) {
     const int w = 64, h = 48, fx = 32, fy = 24;
     const float level = 0.5f, firefly = 500.f;
     Rng rng(5);
@@ -387,58 +391,59 @@ TEST(DenoiseRobustness, AFireflysLightIsKeptAndStaysRoundItsPixel) {
         in.halfB.push_back(Color(level) + 0.05f * Color(gaussian(rng)));
     }
     in.halfA[size_t(fy * w + fx)] = Color(firefly);
-    // The firefly's light in the output: what lies above the level, within
-    // `radius` of the firefly (in the red channel), and the farthest pixel
-    // more than 0.1 above the level (2 noise sigmas of a half).
-    struct Light {
-        double near = 0, all = 0;
-        double farthestBright = 0;
-        int bright = 0;
+    const DenoiseOptions glow;
+    const double sigma = glow.fireflySigma;
+    // The firefly's own light in the noisy image (the mean of the halves),
+    // and the glow it should become: that light times the Gaussian, cut at
+    // 3 sigma and normalised per axis over the pixels inside the image that
+    // it reaches (no light leaves the frame).
+    const double energy = (firefly - level) / 2;
+    const int cut = int(std::ceil(3 * sigma));
+    auto axis = [&](int p, int f, int size) {
+        if (std::abs(p - f) > cut) return 0.0;
+        double sum = 0;
+        for (int q = std::max(0, f - cut); q <= std::min(size - 1, f + cut); ++q)
+            sum += std::exp(-0.5 * (q - f) * (q - f) / (sigma * sigma));
+        return std::exp(-0.5 * (p - f) * (p - f) / (sigma * sigma)) / sum;
     };
-    auto light = [&](const DenoiseOptions& o, double radius) {
+    // What lies above the level (red channel): in all, its largest value, and
+    // its RMS difference from the prescribed glow.
+    struct Light {
+        double all = 0, peak = 0, offGlow = 0;
+    };
+    auto light = [&](const DenoiseOptions& o) {
         const Image d = denoise(in, o);
         Light l;
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
-                const double above = double(d.rgb(x, y).x) - level, r = std::hypot(x - fx, y - fy);
+                const double above = double(d.rgb(x, y).x) - level;
+                const double off = above - energy * axis(x, fx, w) * axis(y, fy, h);
                 l.all += above;
-                if (r <= radius) l.near += above;
-                if (above > 0.1) {
-                    ++l.bright;
-                    l.farthestBright = std::max(l.farthestBright, r);
-                }
+                l.peak = std::max(l.peak, above);
+                l.offGlow += off * off;
             }
+        l.offGlow = std::sqrt(l.offGlow / (w * h));
         return l;
     };
-    DenoiseOptions kept;
-    const double sigma = kept.restoreSigma;
-    // The firefly's own light in the noisy image (the mean of the halves).
-    const double energy = (firefly - level) / 2;
-    const Light with = light(kept, sigma), withTwo = light(kept, 2 * sigma);
+    const Light with = light(glow);
     DenoiseOptions unclamped;
     unclamped.suppressFireflies = false;
-    unclamped.restoreSigma = 0;
-    const Light without = light(unclamped, sigma);
-    DenoiseOptions lost;
-    lost.restoreSigma = 0;
-    const Light clampedOnly = light(lost, sigma);
-    std::printf("[ denoise ] firefly light %.1f: kept %.1f (%.1f within sigma, %.1f within 2 sigma, %d bright, "
-                "farthest %.1f px); unclamped %.1f (%.1f within sigma, %d bright); clamped, not restored %.1f\n",
-                energy, with.all, with.near, withTwo.near, with.bright, with.farthestBright, without.all, without.near,
-                without.bright, clampedOnly.all);
+    const Light without = light(unclamped);
+    DenoiseOptions dropped;
+    dropped.fireflySigma = 0;
+    const Light clampedOnly = light(dropped);
+    std::printf("[ denoise ] firefly light %.1f, glow peak %.3f: kept %.1f (peak %.3f, RMS off the glow %.4f); "
+                "unclamped %.1f (peak %.3f, off %.4f); clamp's light dropped %.1f\n",
+                energy, energy / (2 * 3.14159265 * sigma * sigma), with.all, with.peak, with.offGlow, without.all,
+                without.peak, without.offGlow, clampedOnly.all);
     // Kept: the whole light (the flat frame's noise adds about 0.05 / sqrt(2)
-    // x sqrt(64 x 48) = 2 to the sum), as a Gaussian round the pixel (39 %
-    // of it within sigma, 86 % within 2 sigma) with nothing bright beyond
-    // its 3 sigma cut.
+    // x sqrt(64 x 48) = 2 to the sum), and the prescribed glow to within the
+    // denoised flat frame's own noise.
     EXPECT_NEAR(with.all, energy, 0.02 * energy);
-    EXPECT_GT(with.near, 0.33 * energy);
-    EXPECT_GT(withTwo.near, 0.8 * energy);
-    EXPECT_LE(with.farthestBright, std::ceil(3 * sigma) * std::sqrt(2.0));
-    // Without the clamp: a flat blotch over the search window (19 x 19
-    // pixels), so far less of the light lies within sigma; with the clamp
-    // alone (no restoring), the light is lost.
-    EXPECT_GE(without.bright, 300);
-    EXPECT_LT(without.near, 0.25 * without.all);
+    EXPECT_LT(with.offGlow, 0.02);
+    // Without the clamp: a blotch, far from the glow; with the clamp's light
+    // dropped, the light is lost.
+    EXPECT_GT(without.offGlow, 10 * with.offGlow);
     EXPECT_LT(clampedOnly.all, 0.1 * energy);
 }
 
