@@ -3,8 +3,9 @@
 # (docs/denoise.md; BENCHMARKS.md, "Denoising and the noise target").
 # For each scene: a truth (the path tracer, TRUTH_FACTOR x the largest budget,
 # another seed), whose own noise (its two halves' estimate) is subtracted from
-# every MSE; then at each budget the default method raw (--no-denoise) and
-# denoised (--denoise, the denoiser's time counted), each against the truth:
+# every MSE; then at each budget the default method raw (--no-denoise, --time)
+# and the same samples denoised (--denoise, the raw render's spp and seed; the
+# denoiser's time shown on top), each against the truth:
 # RMSE net of the truth's noise, low-frequency error, and the raw render's
 # own noise estimate beside its measured error.
 # Usage: tools/bench_denoise.sh OUT SCENE...   (env: RES 160x120, BUDGETS "16",
@@ -32,7 +33,10 @@ for scene in "$@"; do
     for b in $BUDGETS; do
         raw="$OUT/$name.$RES.$b.raw.exr"; den="$OUT/$name.$RES.$b.den.exr"
         "$BIN" render "$scene" -o "$raw" --res "$RES" --threads "$THREADS" --time "$b" --seed 11 --no-denoise -q --stats "$raw.json" $EXTRA
-        "$BIN" render "$scene" -o "$den" --res "$RES" --threads "$THREADS" --time "$b" --seed 11 --denoise 2>"$den.log" --stats "$den.json" $EXTRA
+        # The same samples denoised: the raw render's spp and seed, so that the
+        # two images differ by the denoiser alone (two renders of the same time
+        # differ in spp, and their low-frequency noise by up to a third).
+        "$BIN" render "$scene" -o "$den" --res "$RES" --threads "$THREADS" --spp "$(field "$raw.json" "['spp']")" --seed 11 --denoise 2>"$den.log" --stats "$den.json" $EXTRA
         dsec=$(sed -n 's/.*denoised in \([0-9.]*\) s.*/\1/p' "$den.log")
         rr=$(metric "$raw" "$truth" rmse); rd=$(metric "$den" "$truth" rmse)
         lr=$(metric "$raw" "$truth" low_frequency_error); ld=$(metric "$den" "$truth" low_frequency_error)

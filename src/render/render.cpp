@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/memory.h"
+#include "core/sobol.h"
 #include "core/threads.h"
 #include "estimators/estimator.h"
 #include "transport/first_event.h"
@@ -90,6 +91,8 @@ bool isNoiseCheck(int n) { return n >= 16 && nextNoiseCheck(n - 1) == n; }
 
 // Random stream of the feature AOVs, apart from the beauty's.
 constexpr uint64_t AovStream = 0x616f7673;
+// The pixel positions' sequences (one per half render: PixelStream + 0, + 1).
+constexpr uint64_t PixelStream = 0x70697870;
 
 // The layers of the requested AOVs from their sums over `spp` samples. The
 // indirect layer is the beauty minus the direct one, so they add up to the
@@ -289,10 +292,10 @@ void addCameraSample(const Scene& scene, const Estimator& marcher, ThreadContext
     const AovSet& aovs = rs.aovs;
     Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
     float jx = 0.5f, jy = 0.5f;
-    if (rs.pixelJitter) {
-        jx = rng.uniform();
-        jy = rng.uniform();
-    }
+    // Each half render (even and odd samples) takes its pixel positions from
+    // its own scrambled Sobol sequence: stratified within the half, and the
+    // halves independent, as the noise estimate and the denoiser need.
+    if (rs.pixelJitter) sobolPoint2D(uint32_t(s >> 1), hashValues(rs.seed, pixel, PixelStream + uint64_t(s & 1)), jx, jy);
     const Ray ray = scene.camera->generateRay(float(x) + jx, float(y) + jy);
     const PathRadiance pr = marcher.radiance(ray, rng, ctx);
     if (!isFinite(pr.L) || !std::isfinite(pr.transmittance)) {
