@@ -54,9 +54,9 @@ struct DenoiseOptions {
     // is added back, so the denoiser adds no bias at larger scales. 0: off.
     float restoreSigma = 4.f;
     // What the firefly clamp took is added back spread by a Gaussian of this
-    // standard deviation (pixels): a faint glow, and no light lost. 0: the
+    // standard deviation (pixels): a faint haze, and no light lost. 0: the
     // clamp's light is dropped (biased).
-    float fireflySigma = 8.f;
+    float fireflySigma = 32.f;
     float featureStrength = 0.6f;
     float featureThreshold = 1e-3f;
     // The features are first denoised by NL-means guided by themselves
