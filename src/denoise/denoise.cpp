@@ -106,53 +106,21 @@ Plane boxAverage(const Plane& in, int radius) {
     return out;
 }
 
-// A Gaussian of standard deviation `sigma` pixels (cut at 3 sigma) around
-// each pixel, weighted over the pixels inside the image (separable).
-Plane gaussianAverage(const Plane& in, float sigma) {
-    const int w = in.width, h = in.height, radius = int(std::ceil(3.f * sigma));
-    std::vector<float> kernel(size_t(2 * radius + 1));
-    for (int i = -radius; i <= radius; ++i)
-        kernel[size_t(i + radius)] = std::exp(-0.5f * float(i * i) / (sigma * sigma));
-    Plane horizontal(w, h, in.pad), out(w, h, in.pad);
-    forEachRow(h, [&](int y) {
-        const float* src = in.row(y);
-        float* dst = horizontal.row(y);
-        for (int x = 0; x < w; ++x) {
-            float sum = 0, weight = 0;
-            for (int i = std::max(0, x - radius); i <= std::min(w - 1, x + radius); ++i) {
-                const float k = kernel[size_t(i - x + radius)];
-                sum += k * src[i];
-                weight += k;
-            }
-            dst[x] = sum / weight;
-        }
-    });
-    forEachRow(h, [&](int y) {
-        float* dst = out.row(y);
-        for (int x = 0; x < w; ++x) dst[x] = 0;
-        float weight = 0;
-        for (int j = std::max(0, y - radius); j <= std::min(h - 1, y + radius); ++j) {
-            const float k = kernel[size_t(j - y + radius)];
-            const float* src = horizontal.row(j);
-            for (int x = 0; x < w; ++x) dst[x] += k * src[x];
-            weight += k;
-        }
-        for (int x = 0; x < w; ++x) dst[x] /= weight;
-    });
-    return out;
-}
+// A separable Gaussian of standard deviation `sigma` pixels, cut at 3 sigma.
+// Per axis, W(i) is the kernel's weight inside the image around pixel i (the
+// same for a pixel gathering and a pixel giving, the kernel being
+// symmetric). Average: each pixel becomes its neighbours' weighted sum
+// divided by its own W (a constant stays that constant). Spread:
+// each pixel gives its value to its neighbours, divided by its W first (the
+// sum over the image stays that sum).
+enum class GaussianMode { Average, Spread };
 
-// Spreads each pixel's value over a Gaussian of standard deviation `sigma`
-// pixels (cut at 3 sigma), its weights normalised over the pixels inside the
-// image that it reaches (separable): the sum over the image is kept, where
-// gaussianAverage keeps a constant.
-Plane gaussianSpread(const Plane& in, float sigma) {
+Plane gaussian(const Plane& in, float sigma, GaussianMode mode) {
     const int w = in.width, h = in.height, radius = int(std::ceil(3.f * sigma));
     std::vector<float> kernel(size_t(2 * radius + 1));
     for (int i = -radius; i <= radius; ++i)
         kernel[size_t(i + radius)] = std::exp(-0.5f * float(i * i) / (sigma * sigma));
-    // 1 / (the weights a source at i gives to the pixels inside [0, size)).
-    auto inverseReach = [&](int size) {
+    auto inverseWeights = [&](int size) {
         std::vector<float> inverse(static_cast<size_t>(size));
         for (int i = 0; i < size; ++i) {
             float sum = 0;
@@ -162,7 +130,8 @@ Plane gaussianSpread(const Plane& in, float sigma) {
         }
         return inverse;
     };
-    const std::vector<float> inverseX = inverseReach(w), inverseY = inverseReach(h);
+    const std::vector<float> inverseX = inverseWeights(w), inverseY = inverseWeights(h);
+    const bool spread = mode == GaussianMode::Spread;
     Plane horizontal(w, h, in.pad), out(w, h, in.pad);
     forEachRow(h, [&](int y) {
         const float* src = in.row(y);
@@ -170,15 +139,15 @@ Plane gaussianSpread(const Plane& in, float sigma) {
         for (int x = 0; x < w; ++x) {
             float sum = 0;
             for (int i = std::max(0, x - radius); i <= std::min(w - 1, x + radius); ++i)
-                sum += kernel[size_t(i - x + radius)] * src[i] * inverseX[size_t(i)];
-            dst[x] = sum;
+                sum += kernel[size_t(i - x + radius)] * (spread ? src[i] * inverseX[size_t(i)] : src[i]);
+            dst[x] = spread ? sum : sum * inverseX[size_t(x)];
         }
     });
     forEachRow(h, [&](int y) {
         float* dst = out.row(y);
         for (int x = 0; x < w; ++x) dst[x] = 0;
         for (int j = std::max(0, y - radius); j <= std::min(h - 1, y + radius); ++j) {
-            const float k = kernel[size_t(j - y + radius)] * inverseY[size_t(j)];
+            const float k = kernel[size_t(j - y + radius)] * (spread ? inverseY[size_t(j)] : inverseY[size_t(y)]);
             const float* src = horizontal.row(j);
             for (int x = 0; x < w; ++x) dst[x] += k * src[x];
         }
@@ -921,13 +890,13 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                 forEachRow(h, [&](int y) {
                     for (int x = 0; x < w; ++x) change.at(x, y) = clamped[k].at(x, y) - filtered[k].at(x, y);
                 });
-                const Plane restored = gaussianAverage(change, options.restoreSigma);
+                const Plane restored = gaussian(change, options.restoreSigma, GaussianMode::Average);
                 forEachRow(h, [&](int y) {
                     for (int x = 0; x < w; ++x) filtered[k].at(x, y) += restored.at(x, y);
                 });
             }
             if (options.suppressFireflies && options.fireflySigma > 0) {
-                const Plane spread = gaussianSpread(clampedLight[k], options.fireflySigma);
+                const Plane spread = gaussian(clampedLight[k], options.fireflySigma, GaussianMode::Spread);
                 forEachRow(h, [&](int y) {
                     for (int x = 0; x < w; ++x) filtered[k].at(x, y) += spread.at(x, y);
                 });
