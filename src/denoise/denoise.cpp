@@ -25,6 +25,9 @@ constexpr int TileSize = 64;
 // Keeps the distance finite where both variances are 0 (noise-free input):
 // there only (nearly) identical values are averaged.
 constexpr float DistanceEpsilon = 1e-10f;
+// The least colour weight squared (toNextWeakerCandidate): its square is
+// still a normal float.
+constexpr float SquarableWeight = 1e-18f;
 // A pixel distance this large already makes the weight of any patch that
 // holds it negligible (1e4 / 49 > 87 for a 7x7 patch of one channel); the
 // clamp keeps the running sums of the box filter precise.
@@ -178,6 +181,20 @@ inline float expMinus(float d) {
     float scale;
     std::memcpy(&scale, &bits, sizeof scale);
     return p * scale;
+}
+
+// A colour weight e^-d of one candidate to that of the candidate of half
+// its strength, e^-4d: squared twice. SquarableWeight is added before each
+// square, so none underflows into denormals (which are slow); it changes no
+// weight above 1e-10 by more than a part in 1e8, and a weight of 1e-36
+// weighs nothing next to the centre's 1. (Branch-free: GCC vectorises
+// neither a clamp nor a select at this threshold.)
+void toNextWeakerCandidate(float* __restrict e, int n) {
+    for (int x = 0; x < n; ++x) {
+        float v = e[x] + SquarableWeight;
+        v = v * v + SquarableWeight;
+        e[x] = v * v;
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -688,6 +705,62 @@ void featureRowDistance(const std::vector<Feature>& features, int y, int dx, int
     }
 }
 
+// Per pixel, the candidate filter of least estimated error, blended
+// smoothly (Rousselle, Manzi and Zwicker 2013, section 5). A candidate F's
+// error at p is estimated by Stein's unbiased risk estimate,
+//   SURE(p) = |F(p) - y(p)|^2 - s^2(p) + 2 s^2(p) dF(p)/dy(p),
+// y the mean of the halves, s^2 its variance per channel (half the variance
+// of a half), dF/dy = `inverse` (the pixel's own weight over the sum of the
+// weights; the weights' own dependence on y is left out, as in the paper).
+// One pixel's estimate is noisy, so it is box-averaged over
+// (2 radius + 1)^2 pixels before the choice, and the one-hot choices are
+// box-averaged again into blending weights: no seams between regions.
+std::vector<Plane> selectCandidates(const std::vector<std::vector<Plane>>& filtered, const std::vector<Plane>& inverse,
+                                    const std::vector<Plane>& clamped, const std::vector<Plane>& variance,
+                                    int radius) {
+    const size_t candidates = filtered.size(), planes = filtered[0].size();
+    const int w = clamped[0].width, h = clamped[0].height;
+    std::vector<Plane> risk;
+    for (size_t j = 0; j < candidates; ++j) {
+        Plane sure(w, h, 0);
+        forEachRow(h, [&](int y) {
+            for (int x = 0; x < w; ++x) {
+                float sum = 0;
+                for (size_t c = 0; c < 3; ++c) {
+                    const float d = filtered[j][c].at(x, y) - clamped[c].at(x, y);
+                    const float s2 = 0.5f * variance[c].at(x, y);
+                    sum += d * d - s2 + 2.f * s2 * inverse[j].at(x, y);
+                }
+                sure.at(x, y) = sum;
+            }
+        });
+        risk.push_back(boxAverage(sure, radius));
+    }
+    std::vector<Plane> choice(candidates, Plane(w, h, 0));
+    forEachRow(h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            size_t best = 0;
+            for (size_t j = 1; j < candidates; ++j)
+                if (risk[j].at(x, y) < risk[best].at(x, y)) best = j;
+            choice[best].at(x, y) = 1.f;
+        }
+    });
+    for (Plane& c : choice) c = boxAverage(c, radius);
+    std::vector<Plane> out(planes, Plane(w, h, 0));
+    forEachRow(h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            float total = 0;
+            for (size_t j = 0; j < candidates; ++j) total += choice[j].at(x, y);
+            for (size_t c = 0; c < planes; ++c) {
+                float v = 0;
+                for (size_t j = 0; j < candidates; ++j) v += choice[j].at(x, y) * filtered[j][c].at(x, y);
+                out[c].at(x, y) = v / total;
+            }
+        }
+    });
+    return out;
+}
+
 void checkSize(size_t size, size_t pixels, const char* name, bool optional) {
     if (size == pixels || (optional && size == 0)) return;
     throw std::invalid_argument(str("denoise: ", name, " has ", size, " entries, expected ", pixels,
@@ -708,6 +781,9 @@ void checkOptions(const DenoiseOptions& o) {
     radius(o.featureSearchRadius, "featureSearchRadius");
     radius(o.featurePatchRadius, "featurePatchRadius");
     positive(o.colorStrength, "colorStrength");
+    if (o.candidates < 1 || o.candidates > 4)
+        throw std::invalid_argument(str("denoise: candidates ", o.candidates, " is outside [1, 4]"));
+    radius(o.selectionRadius, "selectionRadius");
     positive(o.featureStrength, "featureStrength");
     positive(o.featureThreshold, "featureThreshold");
     positive(o.featurePrefilterStrength, "featurePrefilterStrength");
@@ -809,20 +885,32 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
             halves.secondValues.push_back(&b[size_t(c)]);
             halves.variances.push_back(&variance[size_t(c)]);
         }
-        halves.k2 = options.colorStrength * options.colorStrength;
         halves.norm = 1.f / float(3 * (2 * f + 1) * (2 * f + 1));
 
-        std::vector<Plane> filtered(planes, Plane(w, h, 0));
+        // Candidate filters (Rousselle, Manzi and Zwicker 2013): the same
+        // distances at colour strengths k_j = k_c 2^j. The colour distance
+        // scales as 1/k^2, so a candidate's colour weight is the fourth power
+        // of the next stronger one's: one exponential (of the strongest)
+        // serves them all. `inverse[j]` gets 1/2 (1/sum wA + 1/sum wB), the
+        // derivative of the output with respect to the pixel's own value
+        // (its centre weight is 1), for SURE below.
+        const size_t candidates = size_t(options.candidates);
+        halves.k2 = options.colorStrength * options.colorStrength;
+        const float strongestScale = std::ldexp(1.f, -2 * (options.candidates - 1));
+        std::vector<std::vector<Plane>> filtered(candidates, std::vector<Plane>(planes, Plane(w, h, 0)));
+        std::vector<Plane> inverse(candidates, Plane(w, h, 0));
         forEachTile(w, h, [&](const Rect& tile) {
             const int tw = tile.width(), n = tw * tile.height();
             const size_t tilePixels = static_cast<size_t>(n), tileRow = static_cast<size_t>(tw);
             BoxScratch scratch(TileSize, f);
             std::vector<float> distanceA(tilePixels), distanceB(tilePixels), featureDistance(tileRow),
-                featureScratch(tileRow), weightA(tileRow), weightB(tileRow);
-            // Sums of w * value per channel (A filtered with B's weights, and
-            // B with A's), then the sums of the weights.
-            std::vector<float> sumA(size_t(channels) * size_t(n), 0.f), sumB(size_t(channels) * size_t(n), 0.f),
-                weightsA(size_t(n), 0.f), weightsB(size_t(n), 0.f);
+                featureScratch(tileRow), weightA(tileRow), weightB(tileRow), colourA(tileRow), colourB(tileRow),
+                featureWeight(tileRow);
+            // Per candidate: sums of w * value per channel (A filtered with
+            // B's weights, and B with A's), then the sums of the weights.
+            const size_t sumSize = size_t(channels) * size_t(n);
+            std::vector<float> sumA(candidates * sumSize, 0.f), sumB(candidates * sumSize, 0.f),
+                weightsA(candidates * tilePixels, 0.f), weightsB(candidates * tilePixels, 0.f);
             for (int dy = -radius; dy <= radius; ++dy)
                 for (int dx = -radius; dx <= radius; ++dx) {
                     const Rect r = partnersInside(tile, dx, dy, w, h);
@@ -839,40 +927,65 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                         const float* __restrict dA = &distanceA[size_t(y - r.y0) * size_t(rw)];
                         float* __restrict wA = weightA.data();
                         float* __restrict wB = weightB.data();
-                        const float norm = halves.norm;
-                        for (int x = 0; x < rw; ++x) {
-                            const float colourB = dB[x] * norm, colourA = dA[x] * norm;
-                            wA[x] = clampDistance(colourB > fd[x] ? colourB : fd[x]);
-                            wB[x] = clampDistance(colourA > fd[x] ? colourA : fd[x]);
-                        }
-                        for (int x = 0; x < rw; ++x) wA[x] = expMinus(wA[x]), wB[x] = expMinus(wB[x]);
                         const size_t base = size_t(y - tile.y0) * size_t(tw) + size_t(r.x0 - tile.x0);
-                        float* __restrict sa = &weightsA[base];
-                        float* __restrict sb = &weightsB[base];
-                        for (int x = 0; x < rw; ++x) sa[x] += wA[x], sb[x] += wB[x];
-                        for (int c = 0; c < channels; ++c) {
-                            const float* __restrict qa = a[size_t(c)].row(y + dy) + r.x0 + dx;
-                            const float* __restrict qb = b[size_t(c)].row(y + dy) + r.x0 + dx;
-                            float* __restrict accA = &sumA[size_t(c) * size_t(n) + base];
-                            float* __restrict accB = &sumB[size_t(c) * size_t(n) + base];
-                            for (int x = 0; x < rw; ++x) accA[x] += wA[x] * qa[x], accB[x] += wB[x] * qb[x];
+                        // Colour weights of the strongest candidate and the
+                        // feature weight, then per candidate from the strongest
+                        // down: the colour weight squared twice (a value too
+                        // small to square again without underflow is 0).
+                        float* __restrict eA = colourA.data();
+                        float* __restrict eB = colourB.data();
+                        float* __restrict ef = featureWeight.data();
+                        const float norm = halves.norm * strongestScale;
+                        for (int x = 0; x < rw; ++x) {
+                            eA[x] = clampDistance(dB[x] * norm);
+                            eB[x] = clampDistance(dA[x] * norm);
+                        }
+                        for (int x = 0; x < rw; ++x) ef[x] = clampDistance(fd[x]);
+                        for (int x = 0; x < rw; ++x)
+                            eA[x] = expMinus(eA[x]), eB[x] = expMinus(eB[x]), ef[x] = expMinus(ef[x]);
+                        for (size_t j = candidates; j-- > 0;) {
+                            if (j + 1 < candidates) {
+                                toNextWeakerCandidate(eA, rw);
+                                toNextWeakerCandidate(eB, rw);
+                            }
+                            for (int x = 0; x < rw; ++x) {
+                                wA[x] = eA[x] < ef[x] ? eA[x] : ef[x];
+                                wB[x] = eB[x] < ef[x] ? eB[x] : ef[x];
+                            }
+                            float* __restrict sa = &weightsA[j * tilePixels + base];
+                            float* __restrict sb = &weightsB[j * tilePixels + base];
+                            for (int x = 0; x < rw; ++x) sa[x] += wA[x], sb[x] += wB[x];
+                            for (int c = 0; c < channels; ++c) {
+                                const float* __restrict qa = a[size_t(c)].row(y + dy) + r.x0 + dx;
+                                const float* __restrict qb = b[size_t(c)].row(y + dy) + r.x0 + dx;
+                                const size_t offset = j * sumSize + size_t(c) * size_t(n) + base;
+                                float* __restrict accA = &sumA[offset];
+                                float* __restrict accB = &sumB[offset];
+                                for (int x = 0; x < rw; ++x) accA[x] += wA[x] * qa[x], accB[x] += wB[x] * qb[x];
+                            }
                         }
                     }
                 }
 
             // The centre weight is 1 (its distances are <= 0; to the rounding
             // of the running sums), so the sums of the weights are about >= 1.
-            for (int y = tile.y0; y < tile.y1; ++y)
-                for (int x = tile.x0; x < tile.x1; ++x) {
-                    const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
-                    for (int c = 0; c < channels; ++c) {
-                        const size_t k = size_t(c) * size_t(n) + i;
-                        float v = 0.5f * (sumA[k] / weightsA[i] + sumB[k] / weightsB[i]);
-                        if (!finite(v)) v = 0.5f * (a[size_t(c)].at(x, y) + b[size_t(c)].at(x, y));
-                        filtered[size_t(c)].at(x, y) = v;
+            for (size_t j = 0; j < candidates; ++j)
+                for (int y = tile.y0; y < tile.y1; ++y)
+                    for (int x = tile.x0; x < tile.x1; ++x) {
+                        const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
+                        const float sa = weightsA[j * tilePixels + i], sb = weightsB[j * tilePixels + i];
+                        for (int c = 0; c < channels; ++c) {
+                            const size_t k = j * sumSize + size_t(c) * size_t(n) + i;
+                            float v = 0.5f * (sumA[k] / sa + sumB[k] / sb);
+                            if (!finite(v)) v = 0.5f * (a[size_t(c)].at(x, y) + b[size_t(c)].at(x, y));
+                            filtered[j][size_t(c)].at(x, y) = v;
+                        }
+                        inverse[j].at(x, y) = 0.5f * (1.f / std::max(sa, 1.f) + 1.f / std::max(sb, 1.f));
                     }
-                }
         });
+        std::vector<Plane> selected =
+            candidates == 1 ? std::move(filtered[0])
+                            : selectCandidates(filtered, inverse, clamped, variance, options.selectionRadius);
 
         // The noisy image's local means, restored: NL-means averages each
         // pixel with similar ones wherever they are in the search window,
@@ -888,24 +1001,24 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
             if (options.restoreSigma > 0) {
                 Plane change(w, h, 0);
                 forEachRow(h, [&](int y) {
-                    for (int x = 0; x < w; ++x) change.at(x, y) = clamped[k].at(x, y) - filtered[k].at(x, y);
+                    for (int x = 0; x < w; ++x) change.at(x, y) = clamped[k].at(x, y) - selected[k].at(x, y);
                 });
                 const Plane restored = gaussian(change, options.restoreSigma, GaussianMode::Average);
                 forEachRow(h, [&](int y) {
-                    for (int x = 0; x < w; ++x) filtered[k].at(x, y) += restored.at(x, y);
+                    for (int x = 0; x < w; ++x) selected[k].at(x, y) += restored.at(x, y);
                 });
             }
             if (options.suppressFireflies && options.fireflySigma > 0) {
                 const Plane spread = gaussian(clampedLight[k], options.fireflySigma, GaussianMode::Spread);
                 forEachRow(h, [&](int y) {
-                    for (int x = 0; x < w; ++x) filtered[k].at(x, y) += spread.at(x, y);
+                    for (int x = 0; x < w; ++x) selected[k].at(x, y) += spread.at(x, y);
                 });
             }
         }
         forEachRow(h, [&](int y) {
             for (int x = 0; x < w; ++x) {
                 float value[4] = {0, 0, 0, 1};
-                for (int c = 0; c < channels; ++c) value[c] = filtered[size_t(c)].at(x, y);
+                for (int c = 0; c < channels; ++c) value[c] = selected[size_t(c)].at(x, y);
                 out.set(x, y, Color(value[0], value[1], value[2]), value[3]);
             }
         });

@@ -38,6 +38,11 @@ struct DenoiseOptions {
     // k_c: how far two patches may differ, in standard deviations of their
     // noise, and still be averaged. Larger smooths more.
     float colorStrength = 0.45f;
+    // Candidate filters of strengths k_c, 2 k_c, 4 k_c, ..., blended per
+    // pixel by their estimated error (SURE, Rousselle et al. 2013) over boxes
+    // of (2 selectionRadius + 1)^2 pixels; 1: the k_c filter alone.
+    int candidates = 2;
+    int selectionRadius = 2;
     // Radius of the box that smooths the two-half variance estimate (1
     // degree of freedom per pixel on its own): 2 is 5x5.
     int varianceRadius = 2;

@@ -299,6 +299,8 @@ TEST(DenoiseRobustness, SizeMismatchesAndBadOptionsThrow) {
     throws([](DenoiseInput& in, DenoiseOptions&) { in.width += 1; });
     throws([](DenoiseInput& in, DenoiseOptions&) { in.width = -16; in.height = -12; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.searchRadius = -1; });
+    throws([](DenoiseInput&, DenoiseOptions& o) { o.candidates = 0; });
+    throws([](DenoiseInput&, DenoiseOptions& o) { o.candidates = 5; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.colorStrength = 0; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.threads = -2; });
     throws([](DenoiseInput&, DenoiseOptions& o) { o.restoreSigma = -1; });
@@ -381,6 +383,65 @@ TEST(DenoiseQuality, SparseBrightDetailKeepsItsLowFrequencies) {
 // firefly's light is neither lost nor left as a blotch: it comes back as the
 // Gaussian haze of fireflySigma that the design prescribes (here, in a small
 // frame, over all of it).
+// Candidate filters chosen per pixel by SURE (docs/denoise.md, step 7): on a
+// frame whose left half is a smooth ramp (a strong filter is best) and whose
+// right half holds fine low-contrast stripes (a strong filter blurs them),
+// the blend is, on each half, nearly as good as the best single strength
+// there, and better than every single strength over the whole frame.
+TEST(DenoiseQuality, SureBlendsTheBestCandidateOfEachRegion) {
+    const int w = 160, h = 120;
+    const float sigma = 0.1f;
+    for (uint64_t seed : {1u, 2u, 3u}) {
+        DenoiseInput in;
+        in.width = w;
+        in.height = h;
+        std::vector<Color> truth;
+        Rng rng(seed);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const float u = float(x) / float(w), v = float(y) / float(h);
+                // Stripes of a 3-pixel period along a diagonal, 0.08 high.
+                const float stripes = x < w / 2 ? 0.f : 0.08f * std::sin(2.f * 3.14159265f * float(x + 2 * y) / 3.f);
+                const Color c(0.4f + 0.2f * u + stripes, 0.35f + 0.2f * v + stripes, 0.5f + stripes);
+                truth.push_back(c);
+                const float s = x < w / 2 ? 4 * sigma : sigma;
+                in.halfA.push_back(c + s * Color(gaussian(rng), gaussian(rng), gaussian(rng)));
+                in.halfB.push_back(c + s * Color(gaussian(rng), gaussian(rng), gaussian(rng)));
+            }
+        auto error = [&](const Image& img, int x0, int x1) {
+            double sum = 0;
+            for (int y = 0; y < h; ++y)
+                for (int x = x0; x < x1; ++x) {
+                    const Color d = img.rgb(x, y) - truth[size_t(y) * size_t(w) + size_t(x)];
+                    sum += double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z;
+                }
+            return sum / double(3 * h * (x1 - x0));
+        };
+        // Step 9 (the restored local means) off: its noise floor would hide
+        // the candidates' differences in the smooth half.
+        DenoiseOptions blend;
+        blend.restoreSigma = 0;
+        double bestLeft = 1e30, bestRight = 1e30, bestAll = 1e30;
+        for (int j = 0; j < blend.candidates; ++j) {
+            DenoiseOptions single = blend;
+            single.candidates = 1;
+            single.colorStrength = blend.colorStrength * float(1 << j);
+            const Image out = denoise(in, single);
+            bestLeft = std::min(bestLeft, error(out, 0, w / 2));
+            bestRight = std::min(bestRight, error(out, w / 2, w));
+            bestAll = std::min(bestAll, error(out, 0, w));
+        }
+        const Image out = denoise(in, blend);
+        const double left = error(out, 0, w / 2), right = error(out, w / 2, w), all = error(out, 0, w);
+        std::printf("[ denoise ] SURE blend, seed %d: smooth half %.3g (best single %.3g), stripes %.3g (%.3g), "
+                    "all %.3g (%.3g)\n",
+                    int(seed), left, bestLeft, right, bestRight, all, bestAll);
+        EXPECT_LT(left, 1.2 * bestLeft);
+        EXPECT_LT(right, 1.2 * bestRight);
+        EXPECT_LT(all, bestAll);
+    }
+}
+
 TEST(DenoiseRobustness, AFireflysLightComesBackAsAFaintGlow) {
     const int w = 64, h = 48, fx = 32, fy = 24;
     const float level = 0.5f, firefly = 500.f;
