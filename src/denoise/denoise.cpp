@@ -897,15 +897,15 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
         const size_t candidates = size_t(options.candidates);
         halves.k2 = options.colorStrength * options.colorStrength;
         const float strongestScale = std::ldexp(1.f, -2 * (options.candidates - 1));
+        const bool withFeatures = !features.empty();
         std::vector<std::vector<Plane>> filtered(candidates, std::vector<Plane>(planes, Plane(w, h, 0)));
         std::vector<Plane> inverse(candidates, Plane(w, h, 0));
         forEachTile(w, h, [&](const Rect& tile) {
             const int tw = tile.width(), n = tw * tile.height();
             const size_t tilePixels = static_cast<size_t>(n), tileRow = static_cast<size_t>(tw);
             BoxScratch scratch(TileSize, f);
-            std::vector<float> distanceA(tilePixels), distanceB(tilePixels), featureDistance(tileRow),
-                featureScratch(tileRow), weightA(tileRow), weightB(tileRow), colourA(tileRow), colourB(tileRow),
-                featureWeight(tileRow);
+            std::vector<float> distanceA(tilePixels), distanceB(tilePixels), featureScratch(tileRow),
+                weightA(tileRow), weightB(tileRow), colourA(tileRow), colourB(tileRow), featureWeight(tileRow);
             // Per candidate: sums of w * value per channel (A filtered with
             // B's weights, and B with A's), then the sums of the weights.
             const size_t sumSize = size_t(channels) * size_t(n);
@@ -918,20 +918,13 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                     patchDistances(halves, r, dx, dy, f, scratch, distanceA.data(), distanceB.data());
                     const int rw = r.width();
                     for (int y = r.y0; y < r.y1; ++y) {
-                        float* __restrict fd = featureDistance.data();
-                        if (!features.empty())
-                            featureRowDistance(features, y, dx, dy, r.x0, r.x1, fd, featureScratch.data());
-                        else
-                            for (int x = 0; x < rw; ++x) fd[x] = 0;
                         const float* __restrict dB = &distanceB[size_t(y - r.y0) * size_t(rw)];
                         const float* __restrict dA = &distanceA[size_t(y - r.y0) * size_t(rw)];
-                        float* __restrict wA = weightA.data();
-                        float* __restrict wB = weightB.data();
                         const size_t base = size_t(y - tile.y0) * size_t(tw) + size_t(r.x0 - tile.x0);
                         // Colour weights of the strongest candidate and the
                         // feature weight, then per candidate from the strongest
-                        // down: the colour weight squared twice (a value too
-                        // small to square again without underflow is 0).
+                        // down: the colour weight squared twice; the weight is
+                        // the smaller of colour and feature weight.
                         float* __restrict eA = colourA.data();
                         float* __restrict eB = colourB.data();
                         float* __restrict ef = featureWeight.data();
@@ -940,17 +933,26 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                             eA[x] = clampDistance(dB[x] * norm);
                             eB[x] = clampDistance(dA[x] * norm);
                         }
-                        for (int x = 0; x < rw; ++x) ef[x] = clampDistance(fd[x]);
-                        for (int x = 0; x < rw; ++x)
-                            eA[x] = expMinus(eA[x]), eB[x] = expMinus(eB[x]), ef[x] = expMinus(ef[x]);
+                        for (int x = 0; x < rw; ++x) eA[x] = expMinus(eA[x]), eB[x] = expMinus(eB[x]);
+                        if (withFeatures) {
+                            featureRowDistance(features, y, dx, dy, r.x0, r.x1, ef, featureScratch.data());
+                            for (int x = 0; x < rw; ++x) ef[x] = clampDistance(ef[x]);
+                            for (int x = 0; x < rw; ++x) ef[x] = expMinus(ef[x]);
+                        }
                         for (size_t j = candidates; j-- > 0;) {
                             if (j + 1 < candidates) {
                                 toNextWeakerCandidate(eA, rw);
                                 toNextWeakerCandidate(eB, rw);
                             }
-                            for (int x = 0; x < rw; ++x) {
-                                wA[x] = eA[x] < ef[x] ? eA[x] : ef[x];
-                                wB[x] = eB[x] < ef[x] ? eB[x] : ef[x];
+                            const float* __restrict wA = eA;
+                            const float* __restrict wB = eB;
+                            if (withFeatures) {
+                                for (int x = 0; x < rw; ++x) {
+                                    weightA[size_t(x)] = eA[x] < ef[x] ? eA[x] : ef[x];
+                                    weightB[size_t(x)] = eB[x] < ef[x] ? eB[x] : ef[x];
+                                }
+                                wA = weightA.data();
+                                wB = weightB.data();
                             }
                             float* __restrict sa = &weightsA[j * tilePixels + base];
                             float* __restrict sb = &weightsB[j * tilePixels + base];
