@@ -83,8 +83,10 @@ step "merged == single: bit-identical"
 
 # --- a tile task requeued mid-render (as preemption does) saves its state on
 # SIGTERM, and the requeued task resumes from it: the merge is still
-# bit-identical to one process
-RQ_OPTS=(--res 96x72 --spp 300 --seed 7)
+# bit-identical to one process. The tile must outlast the requeue's delivery
+# (scontrol to SIGTERM): at 300 spp a tile took 0.8 s on a fast machine and
+# finished before the signal came.
+RQ_OPTS=(--res 96x72 --spp 1500 --seed 7)
 step "submitting 2 tiles at ${RQ_OPTS[*]}, checkpointing every 0.3 s"
 sub=$(timeout 60 bash "$ROOT/tools/farm/slurm_submit.sh" --tiles 2 --checkpoint-every 0.3 --vdbmarch "$VDBMARCH" \
   --workdir "$TMP/rq" -o "$TMP/out/rq.exr" "$SCENE" -- "${RQ_OPTS[@]}")
