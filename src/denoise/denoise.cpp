@@ -709,8 +709,8 @@ void featureRowDistance(const std::vector<Feature>& features, int y, int dx, int
 // smoothly (Rousselle, Manzi and Zwicker 2013, section 5). A candidate F's
 // error at p is estimated by Stein's unbiased risk estimate,
 //   SURE(p) = |F(p) - y(p)|^2 - s^2(p) + 2 s^2(p) dF(p)/dy(p),
-// y the mean of the halves, s^2 its variance per channel (half the variance
-// of a half), dF/dy = `inverse` (the pixel's own weight over the sum of the
+// y the mean of the clamped halves (what the candidates averaged), s^2 its
+// variance per channel (half the variance of a half), dF/dy = `inverse` (the pixel's own weight over the sum of the
 // weights; the weights' own dependence on y is left out, as in the paper).
 // One pixel's estimate is noisy, so it is box-averaged over
 // (2 radius + 1)^2 pixels before the choice, and the one-hot choices are
