@@ -14,6 +14,7 @@
 #include "app/bake_command.h"
 #include "app/bench_command.h"
 #include "app/compare_command.h"
+#include "app/huge_page_heap.h"
 #include "app/info_command.h"
 #include "app/inspect_command.h"
 #include "app/merge_command.h"
@@ -37,6 +38,8 @@ void addSceneOptions(CLI::App* command, Args& args, const SceneOptionTable<Args>
 }  // namespace
 
 int main(int argc, char** argv) {
+    // First: it may replace this process by itself with huge pages for the heap.
+    restartWithHugePageHeap(argv);
     removeTemporaryFilesOnInterrupt();
     // VDB files are read once in a child process of this executable first.
     {

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/denoise_frame.h"
+#include "app/huge_page_heap.h"
 #include "app/tiles.h"
 #include "app/vdb_check.h"
 #include "core/atomic_file.h"
@@ -167,7 +168,8 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     s["memory"] = {{"predicted_peak_bytes", predictedMemory},
                    {"peak_bytes", peakResidentMemoryBytes()},
                    {"photon_bytes", r.photonBytes},
-                   {"cache_bytes", r.cacheBytes}};
+                   {"cache_bytes", r.cacheBytes},
+                   {"heap_on_huge_pages", heapOnHugePages()}};
     s["step"] = scene.step;
     s["shadow_step"] = scene.shadowStep;
     s["counters"] = {{"camera_rays", c.cameraRays},         {"surface_hits", c.surfaceHits},
