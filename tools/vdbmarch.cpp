@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
     // First: it may replace this process by itself with huge pages for the heap.
     restartWithHugePageHeap(argv);
     removeTemporaryFilesOnInterrupt();
-    // VDB files are read once in a child process of this executable first.
+    // `check` and baked caches are read in a child process of this executable.
     {
         char self[4096];
         const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
