@@ -38,8 +38,8 @@ void addSceneOptions(CLI::App* command, Args& args, const SceneOptionTable<Args>
 }  // namespace
 
 int main(int argc, char** argv) {
-    // First: it may replace this process by itself with huge pages for the heap.
-    restartWithHugePageHeap(argv);
+    // First: a command that reads grids replaces itself by itself, with huge pages for the heap.
+    restartWithHugePageHeap(argc, argv);
     removeTemporaryFilesOnInterrupt();
     // `check` and baked caches are read in a child process of this executable.
     {

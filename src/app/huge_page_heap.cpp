@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <string>
 
 #include <unistd.h>
 
@@ -52,7 +53,18 @@ HeapRestartPlan planHeapRestart(const char* glibcTunables, const char* savedTuna
     return plan;
 }
 
-void restartWithHugePageHeap(char** argv) {
+bool commandReadsGrids(int argc, const char* const* argv) {
+    if (argc < 2) return false;
+    const std::string command = argv[1];
+    if (command == "render" || command == "bake" || command == "bench" || command == "info" || command == "inspect")
+        return true;
+    if (command != "check") return false;
+    for (int i = 2; i < argc; ++i)
+        if (std::strcmp(argv[i], "--in-process") == 0) return true;
+    return false;
+}
+
+void restartWithHugePageHeap(int argc, char** argv) {
 #if defined(__GLIBC__) && defined(__linux__)
     if (sanitized()) return;
     const char* current = std::getenv("GLIBC_TUNABLES");
@@ -62,7 +74,7 @@ void restartWithHugePageHeap(char** argv) {
         unsetenv(SavedVariable);
         restarted = true;
     }
-    if (plan.action != HeapRestartPlan::Action::Restart) return;
+    if (plan.action != HeapRestartPlan::Action::Restart || !commandReadsGrids(argc, argv)) return;
     const std::optional<std::string> caller = current ? std::optional<std::string>(current) : std::nullopt;
     if (setenv(SavedVariable, plan.saved.c_str(), 1) == 0 && setenv("GLIBC_TUNABLES", plan.tunables.c_str(), 1) == 0)
         execv("/proc/self/exe", argv);
@@ -70,6 +82,7 @@ void restartWithHugePageHeap(char** argv) {
     setOrUnset("GLIBC_TUNABLES", caller);
     unsetenv(SavedVariable);
 #else
+    (void)argc;
     (void)argv;
 #endif
 }

@@ -23,7 +23,14 @@ struct HeapRestartPlan {
 };
 HeapRestartPlan planHeapRestart(const char* glibcTunables, const char* savedTunables, const char* vdbmarchHeap);
 
-// Call first in main(). Replaces the process by the same executable with
+// Whether the command line (argv[1] the command) reads VDB grids, where the
+// heap on huge pages pays: render, bake, bench, info, inspect, and check
+// --in-process (the child of each file `check` reads). A restart costs a
+// second start of the executable (about 50 ms, its libraries linked again),
+// so the others (compare, merge, check's parent, --help) are not restarted.
+bool commandReadsGrids(int argc, const char* const* argv);
+
+// Call first in main(). Where commandReadsGrids, replaces the process by the same executable with
 // the same arguments (exec keeps the pid, descriptors and signal
 // dispositions) and GLIBC_TUNABLES extended by glibc.malloc.hugetlb=1; in
 // the restarted process, restores GLIBC_TUNABLES as the caller had it, so
@@ -31,7 +38,7 @@ HeapRestartPlan planHeapRestart(const char* glibcTunables, const char* savedTuna
 // where the user set glibc.malloc.hugetlb, with VDBMARCH_HEAP=default, off
 // glibc, in sanitizer builds (their allocator is not glibc's), or when exec
 // fails.
-void restartWithHugePageHeap(char** argv);
+void restartWithHugePageHeap(int argc, char** argv);
 
 // True in the process restarted by restartWithHugePageHeap (its heap is on
 // huge pages where the kernel offers them); reported in `render --stats`.

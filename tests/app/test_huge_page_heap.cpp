@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <initializer_list>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -50,6 +52,25 @@ TEST(HugePageHeap, TheCallersChoiceIsKept) {
     EXPECT_EQ(planHeapRestart("glibc.malloc.hugetlb=2", nullptr, nullptr).action, Action::None);
     EXPECT_EQ(planHeapRestart(nullptr, nullptr, "default").action, Action::None);
     EXPECT_EQ(planHeapRestart(nullptr, nullptr, "huge").action, Action::Restart);
+}
+
+TEST(HugePageHeap, OnlyCommandsThatReadGridsRestart) {
+    auto reads = [](std::initializer_list<const char*> args) {
+        std::vector<const char*> argv{"vdbmarch"};
+        argv.insert(argv.end(), args.begin(), args.end());
+        return commandReadsGrids(int(argv.size()), argv.data());
+    };
+    EXPECT_TRUE(reads({"render", "scene.json", "-o", "out.exr"}));
+    EXPECT_TRUE(reads({"bake", "scene.json", "-o", "cache.vdb"}));
+    EXPECT_TRUE(reads({"bench", "scene.json", "-o", "out"}));
+    EXPECT_TRUE(reads({"info", "cloud.vdb"}));
+    EXPECT_TRUE(reads({"inspect", "cache.vdb"}));
+    EXPECT_TRUE(reads({"check", "--in-process", "cloud.vdb"}));
+    EXPECT_FALSE(reads({"check", "cloud.vdb"}));
+    EXPECT_FALSE(reads({"compare", "a.exr", "b.exr"}));
+    EXPECT_FALSE(reads({"merge", "a.exr", "-o", "b.exr"}));
+    EXPECT_FALSE(reads({"--version"}));
+    EXPECT_FALSE(reads({}));
 }
 
 class HugePageHeapCli : public ::testing::Test {
