@@ -66,7 +66,6 @@ bool commandReadsGrids(int argc, const char* const* argv) {
 
 void restartWithHugePageHeap(int argc, char** argv) {
 #if defined(__GLIBC__) && defined(__linux__)
-    if (sanitized()) return;
     const char* current = std::getenv("GLIBC_TUNABLES");
     const HeapRestartPlan plan = planHeapRestart(current, std::getenv(SavedVariable), std::getenv("VDBMARCH_HEAP"));
     if (plan.action == HeapRestartPlan::Action::Restore) {
@@ -74,7 +73,7 @@ void restartWithHugePageHeap(int argc, char** argv) {
         unsetenv(SavedVariable);
         restarted = true;
     }
-    if (plan.action != HeapRestartPlan::Action::Restart || !commandReadsGrids(argc, argv)) return;
+    if (plan.action != HeapRestartPlan::Action::Restart || sanitized() || !commandReadsGrids(argc, argv)) return;
     const std::optional<std::string> caller = current ? std::optional<std::string>(current) : std::nullopt;
     if (setenv(SavedVariable, plan.saved.c_str(), 1) == 0 && setenv("GLIBC_TUNABLES", plan.tunables.c_str(), 1) == 0)
         execv("/proc/self/exe", argv);
