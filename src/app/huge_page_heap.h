@@ -30,14 +30,14 @@ HeapRestartPlan planHeapRestart(const char* glibcTunables, const char* savedTuna
 // so the others (compare, merge, check's parent, --help) are not restarted.
 bool commandReadsGrids(int argc, const char* const* argv);
 
-// Call first in main(). Where commandReadsGrids, replaces the process by the same executable with
-// the same arguments (exec keeps the pid, descriptors and signal
-// dispositions) and GLIBC_TUNABLES extended by glibc.malloc.hugetlb=1; in
-// the restarted process, restores GLIBC_TUNABLES as the caller had it, so
-// that the processes it starts see the caller's environment. Does nothing
-// where the user set glibc.malloc.hugetlb, with VDBMARCH_HEAP=default, off
-// glibc, in sanitizer builds (their allocator is not glibc's), or when exec
-// fails.
+// Call first in main(). Where commandReadsGrids, replaces the process by
+// the same executable with the same arguments (exec keeps the pid,
+// descriptors and signal dispositions) and GLIBC_TUNABLES extended by
+// glibc.malloc.hugetlb=1; in the restarted process, restores GLIBC_TUNABLES
+// as the caller had it, so that the processes it starts see the caller's
+// environment. Does nothing where the user set glibc.malloc.hugetlb, with
+// VDBMARCH_HEAP=default, off glibc, in sanitizer builds (their allocator is
+// not glibc's), or when exec fails.
 void restartWithHugePageHeap(int argc, char** argv);
 
 // True in the process restarted by restartWithHugePageHeap (its heap is on

@@ -92,7 +92,8 @@ TEST_F(HugePageHeapCli, PixelsDoNotDependOnTheHeap) {
     const std::string render = shellQuote(vdbmarchBinary()) + " render scene.json --res 24x18 --spp 4 -q --no-denoise";
     CliResult huge = runShell(render + " -o huge.exr --stats huge.json", dir.path(), capture.path());
     ASSERT_EQ(huge.exitCode, 0) << huge.err;
-    CliResult plain = runShell("env VDBMARCH_HEAP=default " + render + " -o plain.exr --stats plain.json", dir.path(), capture.path());
+    CliResult plain =
+        runShell("env VDBMARCH_HEAP=default " + render + " -o plain.exr --stats plain.json", dir.path(), capture.path());
     ASSERT_EQ(plain.exitCode, 0) << plain.err;
     CliResult chosen = runShell("env GLIBC_TUNABLES=glibc.malloc.hugetlb=0 " + render + " -o chosen.exr --stats chosen.json",
                                 dir.path(), capture.path());
