@@ -36,6 +36,10 @@ void orientOutward(TriangleMesh& mesh);
 // under welding are ignored. An empty mesh is not closed.
 bool isClosed(const TriangleMesh& mesh);
 
+// The point of triangle (a, b, c) closest to p (Ericson 2005, "Real-Time
+// Collision Detection", 5.1.5: by the Voronoi region of p).
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
 // Unit cube centred at the origin: 8 vertices, 12 outward-facing triangles.
 TriangleMesh makeUnitBox();
 

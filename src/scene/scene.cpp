@@ -7,6 +7,90 @@
 
 namespace vdbmarch {
 
+bool crossedByShadowRays(const MaterialDesc& m) {
+    return m.type == MaterialDesc::Type::Interface || (m.type == MaterialDesc::Type::Dielectric && m.ior == 1.f);
+}
+
+int regionAtRayStart(const Scene& scene, const Ray& r) {
+    SurfaceHit h;
+    if (!scene.surfaceSet->intersect(r, 0.f, Infinity, h)) return Scene::WorldRegion;
+    const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
+    return dot(r.d, h.n) > 0 ? s.interiorRegion : s.exteriorRegion;
+}
+
+namespace {
+
+// Whether p may lie inside one of the closed surfaces `around`: by the
+// parity of each surface's crossings along three rays from p. Any odd count
+// (or a walk cut short) says inside, so a ray grazing an edge errs on the
+// safe side.
+bool mayBeInside(const Scene& scene, const Vec3& p, const std::vector<int>& around) {
+    const Vec3 dirs[3] = {normalize(Vec3(0.267f, 0.534f, 0.802f)), normalize(Vec3(-0.719f, 0.113f, -0.686f)),
+                          normalize(Vec3(0.371f, -0.928f, 0.031f))};
+    for (const Vec3& d : dirs) {
+        std::vector<int> crossings(around.size(), 0);
+        Ray r{p, d};
+        float tMin = 0;
+        int hits = 0;
+        SurfaceHit h;
+        while (scene.surfaceSet->intersect(r, tMin, Infinity, h)) {
+            if (++hits > 100000) return true;
+            for (size_t k = 0; k < around.size(); ++k) crossings[k] += h.surface == around[k];
+            tMin = h.t * (1 + 1e-6f) + 1e-6f * scene.sceneScale;
+        }
+        for (int c : crossings)
+            if (c % 2) return true;
+    }
+    return false;
+}
+
+// Scene::shadowRaysCanReach. A region is sealed when every surface that
+// names it is closed, blocks shadow rays and has it as its interior (so the
+// region lies inside those surfaces, bounded); a light is then out of reach
+// when it lies outside all of them: any straight ray from the region to it
+// crosses one.
+void computeShadowReach(Scene& scene) {
+    const size_t nLights = scene.lights.size(), nRegions = scene.regions.size();
+    scene.shadowReach.assign(nRegions * (nLights + 1), 1);
+    for (size_t r = 0; r < nRegions; ++r) {
+        if (r == size_t(Scene::WorldRegion)) continue;
+        std::vector<int> around;
+        bool sealed = true;
+        for (size_t s = 0; s < scene.surfaces.size(); ++s) {
+            const SurfaceInfo& info = scene.surfaces[s];
+            if (info.interiorRegion != int(r) && info.exteriorRegion != int(r)) continue;
+            around.push_back(int(s));
+            sealed = sealed && info.interiorRegion == int(r) && info.exteriorRegion != int(r) && info.closed &&
+                     !crossedByShadowRays(info.material);
+        }
+        if (!sealed || around.empty()) continue;
+        char* reach = &scene.shadowReach[r * (nLights + 1)];
+        reach[nLights] = 0;  // the environment: outside every closed surface
+        for (size_t i = 0; i < nLights; ++i) {
+            const LightDesc& l = scene.lights[i].desc();
+            switch (l.type) {
+                case LightDesc::Type::Directional:
+                    reach[i] = 0;
+                    break;
+                case LightDesc::Type::Point:
+                case LightDesc::Type::Spot:
+                    reach[i] = mayBeInside(scene, l.position, around);
+                    break;
+                case LightDesc::Type::Sphere: {
+                    bool near = mayBeInside(scene, l.position, around);
+                    for (int s : around) near = near || scene.surfaceSet->mayComeWithin(s, l.position, l.radius * 1.001f);
+                    reach[i] = near;
+                    break;
+                }
+                default:  // a collimated quad may cross the surfaces anywhere
+                    break;
+            }
+        }
+    }
+}
+
+}  // namespace
+
 std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     auto scene = std::make_unique<Scene>();
     scene->desc = desc;
@@ -88,6 +172,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
         else if (sd.shape == SurfaceDesc::Shape::Mesh) mesh = loadMesh(sd.file);
         else mesh = meshVdbIsosurface(sd.file, sd.grid, sd.isovalue);
         transformMesh(mesh, [&](const Vec3& p) { return xf.point(p); });
+        scene->surfaces.back().closed = isClosed(mesh);
         if (sd.shape == SurfaceDesc::Shape::Mesh && !isClosed(mesh)) {
             if (!sd.interior.empty())
                 warn(str(desc.file, ": surfaces[", i, "] (", sd.file,
@@ -120,6 +205,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     float autoStep = std::isfinite(voxel) ? voxel : (maxSigmaT > 0 ? 0.1f / maxSigmaT : 1.f);
     scene->step = desc.render.step > 0 ? desc.render.step : autoStep;
     scene->shadowStep = desc.render.shadowStep > 0 ? desc.render.shadowStep : scene->step;
+    computeShadowReach(*scene);
     return scene;
 }
 

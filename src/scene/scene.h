@@ -26,7 +26,12 @@ struct SurfaceInfo {
     MaterialDesc material;
     int interiorRegion = 1;  // vacuum unless `interior` names a medium
     int exteriorRegion = 0;  // the world media unless `exterior` names one
+    bool closed = true;      // a sphere, a box or a watertight mesh
 };
+
+// True when a straight shadow ray crosses the surface (interfaces and
+// index-matched glass); every other surface blocks it.
+bool crossedByShadowRays(const MaterialDesc& material);
 
 class Scene {
 public:
@@ -44,7 +49,22 @@ public:
     float step = 1, shadowStep = 1;  // world units
     float sceneScale = 1;            // size of the scene, for ray offsets
     bool hasSphereLights = false;
+
+    // Whether a shadow ray that starts in `region` can ever reach light
+    // `light` (lights.size(): the environment). False only where every
+    // surface around the region is closed and blocks shadow rays (glass
+    // that bends light, opaque objects) and the light is not inside it: a
+    // medium in a glass knot never sees a light outside the glass directly,
+    // so next-event estimation there would cast shadow rays that are all
+    // blocked.
+    bool shadowRaysCanReach(int region, size_t light) const {
+        return shadowReach.empty() || shadowReach[size_t(region) * (lights.size() + 1) + light] != 0;
+    }
+    std::vector<char> shadowReach;  // regions x (lights + 1), filled by buildScene
 };
+
+// Region that a ray starting at r.o is in, from the first surface it meets.
+int regionAtRayStart(const Scene& scene, const Ray& r);
 
 // Loads every file the description names and validates the combination.
 std::unique_ptr<Scene> buildScene(const SceneDesc& desc);

@@ -180,4 +180,25 @@ BBox SurfaceSet::bounds() const {
     return b;
 }
 
+bool SurfaceSet::mayComeWithin(int surfaceIndex, const Vec3& c, float r) const {
+    const float r2 = r * r;
+    for (const Geometry& g : mGeometries) {
+        if (g.surface != surfaceIndex) continue;
+        if (g.sphere) {
+            BBox b;
+            for (int i = 0; i < 8; ++i)
+                b.expand(g.toWorld.point(Vec3(i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 1.f : -1.f)));
+            if (lengthSquared(c - min(max(c, b.lo), b.hi)) <= r2) return true;
+            continue;
+        }
+        const std::vector<uint32_t>& idx = g.mesh.indices;
+        for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+            const Vec3 q = closestPointOnTriangle(c, g.mesh.positions[idx[t]], g.mesh.positions[idx[t + 1]],
+                                                  g.mesh.positions[idx[t + 2]]);
+            if (lengthSquared(c - q) <= r2) return true;
+        }
+    }
+    return false;
+}
+
 }  // namespace vdbmarch

@@ -39,6 +39,10 @@ public:
     bool intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit) const;
     // World bounds of every surface (empty box when there are none).
     BBox bounds() const;
+    // Whether surface `surfaceIndex` may come within distance r of c: exact
+    // for meshes (closest point on each triangle), by its bounding box for
+    // spheres (so true errs on the safe side).
+    bool mayComeWithin(int surfaceIndex, const Vec3& c, float r) const;
     // Number of triangles and spheres, for stats.
     size_t primitiveCount() const;
 

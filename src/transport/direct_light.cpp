@@ -62,6 +62,7 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         const Light& light = scene.lights[i];
         if (o.onlyLight >= 0 && int(i) != o.onlyLight) continue;
         if (o.skipPointLights && light.isPointLike()) continue;
+        if (!scene.shadowRaysCanReach(region, i)) continue;  // sealed off: every shadow ray would be blocked
         float lightWeight = o.lightWeights ? o.lightWeights[i] : 1.f;
         if (!(lightWeight > 0) || !russianRoulette(lightWeight, rng, MisWeightRouletteThreshold)) continue;
         LightSample ls;
@@ -77,6 +78,7 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
     }
     if (o.onlyLight >= 0) return L;
     const Environment& env = scene.environment;
+    if (!scene.shadowRaysCanReach(region, scene.lights.size())) return L;
     // An environment map is a light: sampled by its texel power, weighed by
     // the power heuristic against the direction sampling of f, done by the
     // path that goes on (misWithPathHits) or below (sampleBackground). A

@@ -35,17 +35,6 @@ RaySegment nextRaySegment(const Scene& scene, const Ray& r) {
     return seg;
 }
 
-int regionAtRayStart(const Scene& scene, const Ray& r) {
-    SurfaceHit h;
-    if (!scene.surfaceSet->intersect(r, 0.f, Infinity, h)) return Scene::WorldRegion;
-    const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];
-    return dot(r.d, h.n) > 0 ? s.interiorRegion : s.exteriorRegion;
-}
-
-bool crossedByShadowRays(const MaterialDesc& m) {
-    return m.type == MaterialDesc::Type::Interface || (m.type == MaterialDesc::Type::Dielectric && m.ior == 1.f);
-}
-
 bool hasBendingGlass(const Scene& scene) {
     for (const SurfaceInfo& s : scene.surfaces)
         if (s.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(s.material)) return true;

@@ -31,19 +31,12 @@ struct SurfaceEvent {
 SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& hit, const Vec3& d, int region, const float u[3],
                                 TransportMode mode);
 
-// True when a straight shadow ray crosses the surface (interfaces and
-// index-matched glass); every other surface blocks it.
-bool crossedByShadowRays(const MaterialDesc& material);
-
 // True when some surface refracts or reflects (a dielectric with ior != 1):
 // light that passes it cannot be followed by shadow rays.
 bool hasBendingGlass(const Scene& scene);
 
 // Offset origin for a ray leaving a surface at p in direction d.
 Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d);
-
-// Region that a ray starting at r.o is in, from the first surface it meets.
-int regionAtRayStart(const Scene& scene, const Ray& r);
 
 // Closest sphere light hit in (tMin, tMax); returns the light index or -1.
 int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tMax, float& t);
