@@ -134,6 +134,14 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
                      "\") has emission but sigma_a = 0: emission enters as sigma_a L_e, so it is invisible"));
         scene->media.push_back(std::move(m));
     }
+    for (Region& region : scene->regions) {
+        region.constant = !region.media.empty();
+        for (int mi : region.media) {
+            const MediumDesc& md = desc.media[size_t(mi)];
+            region.constant = region.constant && md.type == MediumDesc::Type::Homogeneous && !md.hasBounds &&
+                              !scene->media[size_t(mi)]->hasEmission;
+        }
+    }
     if (isPathTracer(desc.render.method)) {
         bool deltaLight = false, glassWithMedium = false;
         for (const auto& l : desc.lights) deltaLight = deltaLight || l.type != LightDesc::Type::Sphere;

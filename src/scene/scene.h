@@ -20,6 +20,9 @@ struct Region {
     std::vector<int> media;
     Color unboundedSigmaT{0, 0, 0};  // summed extinction of its unbounded homogeneous media
     bool gridded = false;            // holds a VDB medium (its rays march a grid)
+    // Every medium in it is homogeneous, unbounded and not emissive: the
+    // extinction is unboundedSigmaT everywhere in the region.
+    bool constant = false;
 };
 
 struct SurfaceInfo {

@@ -150,6 +150,17 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     return seg;
 }
 
+bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights) {
+    const Scene& scene = ctx.scene;
+    if (scene.desc.render.volumeSampling == VolumeSampling::Distance || scene.lights.empty()) return false;
+    if (ctx.lightDistanceCandidate.empty()) buildCandidates(ctx);
+    const size_t nLights = scene.lights.size();
+    for (size_t i = 0; i < nLights; ++i)
+        if (ctx.lightDistanceCandidate[size_t(region) * nLights + i] && !(skipPointLights && scene.lights[i].isPointLike()))
+            return true;
+    return false;
+}
+
 Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng) {
     const std::vector<ThreadContext::LightDistance>& samplers = ctx.lightDistances;
     if (samplers.empty()) return Color(0);

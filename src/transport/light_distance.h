@@ -49,6 +49,10 @@ struct LightDistanceSegment {
 LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
                                            bool skipPointLights);
 
+// Whether some light may get distance samples on segments in `region`
+// (prepareLightDistances then needs the segment's true end).
+bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights);
+
 // One distance sample, for one prepared light (chosen by its odds):
 // T(t) sigma_s(t) f L T_shadow w / pdf(t), the light's single scattering
 // along the segment weighted for MIS.

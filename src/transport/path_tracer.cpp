@@ -25,6 +25,22 @@ DirectLightOptions nextEventOptions(const PathState& st, const float* lightWeigh
     return o;
 }
 
+// A free flight in a region of constant media seldom goes far where they
+// are dense (exp1_sphere's milk: a mean free path of 0.02 in a knot of size
+// 1): the surface is looked for only within ProbeFreePaths mean free paths,
+// where Embree prunes most of its tree, and a path that passes them without
+// a collision goes on from there. Delta tracking is memoryless, so the cut
+// changes no distribution; it is made only where nothing else reads the
+// segment's end (no guided flight, no distance sampling towards lights).
+constexpr float ProbeFreePaths = 3;
+float probeLength(ThreadContext& ctx, int region, int channel, const PathState& st) {
+    const Region& r = ctx.scene.regions[size_t(region)];
+    if (!r.constant) return Infinity;
+    const float sigmaT = trackedSigmaT(r.unboundedSigmaT, channel);
+    if (!(sigmaT > 0) || regionHasLightDistances(ctx, region, st.pointLightsByPhotons)) return Infinity;
+    return ProbeFreePaths / sigmaT;
+}
+
 // Russian roulette on the throughput after RouletteMinDepth events.
 bool roulette(Color& beta, int depth, Rng& rng) {
     return depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold);
@@ -66,18 +82,20 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     };
     std::array<SplitCopy, MaxSplitPaths - 1> copies;
     while (true) {
-        const RaySegment seg = nextRaySegment(scene, ray);
-        const SurfaceHit& h = seg.surface;
-        const bool hit = seg.hitSurface;
-        const int light = seg.light;
-        const float tEnd = seg.tEnd;
-
         // A guide may take this segment's free flight (path_guide.h); at
         // max_depth a collision could only end the path, so it is tracked.
         // Guided roulette's pixel estimate needs the camera path's first
         // segment prepared even where flights stay with delta tracking.
         const bool wantEstimate = st.guide && startDepth == 0 && !(st.windowReference > 0) && st.guide->guidesRoulette();
         const bool flights = st.guide && st.depth < maxDepth && st.guide->guidesFlights(region);
+
+        const RaySegment seg =
+            nextRaySegment(scene, ray, flights || wantEstimate ? Infinity : probeLength(ctx, region, channel, st));
+        const SurfaceHit& h = seg.surface;
+        const bool hit = seg.hitSurface;
+        const int light = seg.light;
+        const float tEnd = seg.tEnd;
+
         const bool prepared = (flights || wantEstimate) && st.guide->prepareFlight(ctx, region, ray, tEnd, channel);
         const bool guided = prepared && flights;
 
@@ -196,6 +214,10 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             continue;
         }
         // Reached tEnd without a real collision.
+        if (seg.cut) {  // the end of the probed length: the same free flight goes on
+            ray.o = ray.at(tEnd);
+            continue;
+        }
         if (light >= 0) {
             const Light& l = scene.lights[size_t(light)];
             float w = 1;

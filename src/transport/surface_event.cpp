@@ -25,13 +25,14 @@ int intersectSphereLights(const Scene& scene, const Ray& r, float tMin, float tM
     return best;
 }
 
-RaySegment nextRaySegment(const Scene& scene, const Ray& r) {
+RaySegment nextRaySegment(const Scene& scene, const Ray& r, float tMax) {
     RaySegment seg;
-    seg.hitSurface = scene.surfaceSet->intersect(r, 0.f, Infinity, seg.surface);
-    const float tSurface = seg.hitSurface ? seg.surface.t : Infinity;
+    seg.hitSurface = scene.surfaceSet->intersect(r, 0.f, tMax, seg.surface);
+    const float tSurface = seg.hitSurface ? seg.surface.t : tMax;
     float tLight = Infinity;
     seg.light = intersectSphereLights(scene, r, SphereLightRayOffset * scene.sceneScale, tSurface, tLight);
     seg.tEnd = seg.light >= 0 ? tLight : tSurface;
+    seg.cut = !seg.hitSurface && seg.light < 0 && std::isfinite(tMax);
     return seg;
 }
 

@@ -54,8 +54,10 @@ struct RaySegment {
     SurfaceHit surface;
     bool hitSurface = false;
     int light = -1;         // the sphere light hit before any surface, or -1
-    float tEnd = Infinity;  // the light's hit, else the surface's, else Infinity
+    float tEnd = Infinity;  // the light's hit, else the surface's, else tMax
+    // Nothing was looked for beyond a finite tMax: the ray goes on past tEnd.
+    bool cut = false;
 };
-RaySegment nextRaySegment(const Scene& scene, const Ray& r);
+RaySegment nextRaySegment(const Scene& scene, const Ray& r, float tMax = Infinity);
 
 }  // namespace vdbmarch

@@ -245,6 +245,26 @@ TEST(Reference, FurnaceWithAlbedoOneIsFlatAtTheBackground) {
     }
 }
 
+// The same furnace with the medium filling an interface sphere (a region of
+// constant media, whose free flights look for the surface only a few mean
+// free paths ahead and go on from there: path_tracer.cpp, probeLength). With
+// 30-60 mean free paths across the sphere most flights are cut short; any
+// light lost or gained at a cut moves the mean off 1.
+TEST(Reference, FurnaceHoldsWhereFreeFlightsAreCutShort) {
+    for (const char* sigma : {"30", "[15, 30, 60]"}) {
+        RenderResult r = renderImage(*sceneFromJson(str(
+            R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_deg": 40, "resolution": [24, 24]},
+            "media": [{"name": "dense", "type": "homogeneous", "sigma_a": 0, "sigma_s": )", sigma, R"(, "g": 0.7}],
+            "surfaces": [{"shape": "sphere", "material": {"type": "interface"}, "interior": "dense"}],
+            "background": [1, 1, 1], "render": {"method": "reference", "spp": 8, "max_depth": 100000, "seed": 5}})")));
+        EXPECT_EQ(r.counters.nonFiniteSamples, 0u);
+        for (int c = 0; c < 3; ++c) {
+            ChannelStats s = pixelStats(r.image, c);
+            EXPECT_NEAR(s.mean, 1.0, 4 * s.stdError + 1e-6) << "sigma_s " << sigma << " channel " << c;
+        }
+    }
+}
+
 // Transmittance through a VDB box: the reference's alpha is the fraction of
 // paths that scattered or were absorbed, whose expectation is 1 - T.
 TEST(Reference, VdbBoxAlphaIsBeerLambertInExpectation) {
