@@ -167,12 +167,20 @@ bool SurfaceSet::intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit
     return true;
 }
 
+namespace {
+// World bounds of a unit sphere placed by toWorld: its cube's eight corners.
+BBox sphereBounds(const Transform& toWorld) {
+    BBox b;
+    for (int i = 0; i < 8; ++i) b.expand(toWorld.point(Vec3(i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 1.f : -1.f)));
+    return b;
+}
+}  // namespace
+
 BBox SurfaceSet::bounds() const {
     BBox b;
     for (const Geometry& g : mGeometries) {
         if (g.sphere) {
-            for (int i = 0; i < 8; ++i)
-                b.expand(g.toWorld.point(Vec3(i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 1.f : -1.f)));
+            b.expand(sphereBounds(g.toWorld));
         } else {
             for (const Vec3& p : g.mesh.positions) b.expand(p);
         }
@@ -185,9 +193,7 @@ bool SurfaceSet::mayComeWithin(int surfaceIndex, const Vec3& c, float r) const {
     for (const Geometry& g : mGeometries) {
         if (g.surface != surfaceIndex) continue;
         if (g.sphere) {
-            BBox b;
-            for (int i = 0; i < 8; ++i)
-                b.expand(g.toWorld.point(Vec3(i & 1 ? 1.f : -1.f, i & 2 ? 1.f : -1.f, i & 4 ? 1.f : -1.f)));
+            const BBox b = sphereBounds(g.toWorld);
             if (lengthSquared(c - min(max(c, b.lo), b.hi)) <= r2) return true;
             continue;
         }

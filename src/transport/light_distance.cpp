@@ -89,20 +89,27 @@ void buildCandidates(ThreadContext& ctx) {
 
 }  // namespace
 
+bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights) {
+    const Scene& scene = ctx.scene;
+    if (scene.desc.render.volumeSampling == VolumeSampling::Distance || scene.lights.empty()) return false;
+    if (ctx.lightDistanceCandidate.empty()) buildCandidates(ctx);
+    const size_t nLights = scene.lights.size();
+    for (size_t i = 0; i < nLights; ++i)
+        if (ctx.lightDistanceCandidate[size_t(region) * nLights + i] && !(skipPointLights && scene.lights[i].isPointLike()))
+            return true;
+    return false;
+}
+
 LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
                                            bool skipPointLights) {
     ctx.lightDistances.clear();
     const Scene& scene = ctx.scene;
     const VolumeSampling mode = scene.desc.render.volumeSampling;
     LightDistanceSegment seg{ray, region, channel, mode == VolumeSampling::Equiangular};
-    if (mode == VolumeSampling::Distance || scene.lights.empty()) return seg;
-    if (ctx.lightDistanceCandidate.empty()) buildCandidates(ctx);
+    if (!regionHasLightDistances(ctx, region, skipPointLights)) return seg;
     const size_t nLights = scene.lights.size();
     const char* candidate = ctx.lightDistanceCandidate.data() + size_t(region) * nLights;
     auto eligible = [&](size_t i) { return candidate[i] && !(skipPointLights && scene.lights[i].isPointLike()); };
-    bool any = false;
-    for (size_t i = 0; i < nLights && !any; ++i) any = eligible(i);
-    if (!any) return seg;
     // The segment's part in the region's scattering media.
     float a = 0, b = tEnd;
     if (!ctx.scatterBounds[size_t(region)].intersect(ray, a, b) || !(b > a)) return seg;
@@ -148,17 +155,6 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     }
     seg.active = !ctx.lightDistances.empty();
     return seg;
-}
-
-bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights) {
-    const Scene& scene = ctx.scene;
-    if (scene.desc.render.volumeSampling == VolumeSampling::Distance || scene.lights.empty()) return false;
-    if (ctx.lightDistanceCandidate.empty()) buildCandidates(ctx);
-    const size_t nLights = scene.lights.size();
-    for (size_t i = 0; i < nLights; ++i)
-        if (ctx.lightDistanceCandidate[size_t(region) * nLights + i] && !(skipPointLights && scene.lights[i].isPointLike()))
-            return true;
-    return false;
 }
 
 Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng) {
