@@ -6,6 +6,7 @@
 #include "transport/direct_light.h"
 #include "transport/path_tracer.h"
 #include "transport/roulette.h"
+#include "transport/sphere_caustics.h"
 #include "transport/surface_event.h"
 
 namespace vdbmarch {
@@ -164,6 +165,14 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     if (mProductSampling && m.buildProductSampler(*mIllumination->cache, x, rayDir, mp, nextEventVertex))
         product = &m.productSampler;
     Color Li = direct(directLight(ctx, region, nextEventVertex, rng, kNextEvent));
+    // Sphere lights through glass spheres too, weighed against the
+    // continuation's own hits (transport/sphere_caustics.h).
+    const bool caustics = regionHasSphereCaustics(mScene, region);
+    if (caustics) {
+        const Color Lc = sphereCausticLight(ctx, region, nextEventVertex, rng, TransmittanceEstimator::UnbiasedMarching);
+        Li += Lc;
+        if (tallyHere) m.liDirect += Lc;
+    }
     const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
     if (tracePathHere) {
@@ -178,7 +187,14 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         } else {
             wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
         }
-        const PathState state{depth, false, pdf, x, il.pointLightsByPhotons};
+        PathState state;
+        state.depth = depth;
+        state.specular = false;
+        state.lastPdf = pdf;
+        state.lastPoint = x;
+        state.pointLightsByPhotons = il.pointLightsByPhotons;
+        state.causticsAtLast = caustics;
+        state.lastDir = wi;
         if (pdf > 0 && !mChromatic) {
             const PathRadiance p = tracePath(ctx, Ray{x, wi}, region, -1, rng, state);
             Li += weight * p.L;

@@ -113,6 +113,9 @@ struct RenderSettings {
     bool productSampling = false;  // measured slower to converge on cloud_sun and exp1_sphere (BENCHMARKS.md)
     AovSet aovs;  // none by default: the EXR holds RGBA only
     VolumeSampling volumeSampling = VolumeSampling::Mis;
+    // Path vertices connect to sphere lights through glass spheres
+    // (transport/sphere_caustics.h), weighed by MIS against the path's hits.
+    bool sphereCaustics = true;
     // Noise target (render --noise): > 0 stops the render once the
     // estimated RMSE over the image's mean is below it, sampling only the
     // blocks of pixels still above it (adaptive sampling, docs/noise.md).

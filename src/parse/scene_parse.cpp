@@ -312,7 +312,7 @@ AovSet parseAovs(const JsonReader& r) {
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
                  "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "guided_roulette", "aovs",
-                 "volume_sampling", "noise", "denoise"});
+                 "volume_sampling", "sphere_caustics", "noise", "denoise"});
     RenderSettings s;
     {
         std::vector<std::string> names = {"auto"};
@@ -348,6 +348,7 @@ RenderSettings parseRender(const JsonReader& r) {
         s.volumeSampling = v == "distance" ? VolumeSampling::Distance
                            : v == "equiangular" ? VolumeSampling::Equiangular : VolumeSampling::Mis;
     }
+    s.sphereCaustics = r.boolean("sphere_caustics", s.sphereCaustics);
     if (r.has("noise")) s.noise = float(r.numberIn("noise", 0, 1e-4, 10));
     {
         const std::string v = r.choice("denoise", "preview", {"preview", "on", "off"});

@@ -49,6 +49,39 @@ bool mayBeInside(const Scene& scene, const Vec3& p, const std::vector<int>& arou
 // region lies inside those surfaces, bounded); a light is then out of reach
 // when it lies outside all of them: any straight ray from the region to it
 // crosses one.
+// The spheres of refracting glass, uniformly scaled and empty inside, that
+// next-event estimation sees light through (transport/sphere_caustics.h).
+void findGlassSpheres(Scene& scene) {
+    for (size_t i = 0; i < scene.desc.surfaces.size(); ++i) {
+        const SurfaceDesc& sd = scene.desc.surfaces[i];
+        const SurfaceInfo& info = scene.surfaces[i];
+        if (sd.shape != SurfaceDesc::Shape::Sphere || info.material.type != MaterialDesc::Type::Dielectric ||
+            crossedByShadowRays(info.material) || !scene.regions[size_t(info.interiorRegion)].media.empty())
+            continue;
+        // Uniform scale: three orthogonal columns of one length.
+        const Mat4& m = sd.transform;
+        double len[3], dots[3];
+        for (int c = 0; c < 3; ++c) {
+            const int c2 = (c + 1) % 3;
+            len[c] = std::sqrt(m.m[0][c] * m.m[0][c] + m.m[1][c] * m.m[1][c] + m.m[2][c] * m.m[2][c]);
+            dots[c] = m.m[0][c] * m.m[0][c2] + m.m[1][c] * m.m[1][c2] + m.m[2][c] * m.m[2][c2];
+        }
+        const double r = len[0];
+        if (!(r > 0) || std::fabs(len[1] - r) > 1e-6 * r || std::fabs(len[2] - r) > 1e-6 * r) continue;
+        if (std::fabs(dots[0]) > 1e-6 * r * r || std::fabs(dots[1]) > 1e-6 * r * r || std::fabs(dots[2]) > 1e-6 * r * r)
+            continue;
+        GlassSphere g;
+        g.center = Vec3(float(m.m[0][3]), float(m.m[1][3]), float(m.m[2][3]));
+        g.radius = float(r);
+        g.ior = info.material.ior;
+        g.surface = int(i);
+        g.outside = info.exteriorRegion;
+        for (size_t j = 0; j < scene.surfaces.size(); ++j)
+            if (j != i && scene.surfaceSet->mayComeWithin(int(j), g.center, g.radius)) g.clearInside = false;
+        scene.glassSpheres.push_back(g);
+    }
+}
+
 void computeShadowReach(Scene& scene) {
     const size_t nLights = scene.lights.size(), nRegions = scene.regions.size();
     scene.shadowReach.assign(nRegions * (nLights + 1), 1);
@@ -214,6 +247,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     scene->step = desc.render.step > 0 ? desc.render.step : autoStep;
     scene->shadowStep = desc.render.shadowStep > 0 ? desc.render.shadowStep : scene->step;
     computeShadowReach(*scene);
+    findGlassSpheres(*scene);
     return scene;
 }
 

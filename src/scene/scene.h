@@ -32,6 +32,18 @@ struct SurfaceInfo {
     bool closed = true;      // a sphere, a box or a watertight mesh
 };
 
+// A smooth glass sphere that next-event estimation sees light through
+// (transport/sphere_caustics.h): a sphere surface of refracting dielectric,
+// uniformly scaled, with no medium inside.
+struct GlassSphere {
+    Vec3 center;
+    float radius = 1;
+    float ior = 1.5f;
+    int surface = -1;
+    int outside = 0;          // the region around it
+    bool clearInside = true;  // no other surface comes inside it
+};
+
 // True when a straight shadow ray crosses the surface (interfaces and
 // index-matched glass); every other surface blocks it.
 bool crossedByShadowRays(const MaterialDesc& material);
@@ -52,6 +64,7 @@ public:
     float step = 1, shadowStep = 1;  // world units
     float sceneScale = 1;            // size of the scene, for ray offsets
     bool hasSphereLights = false;
+    std::vector<GlassSphere> glassSpheres;
 
     // Whether a shadow ray that starts in `region` can ever reach light
     // `light` (lights.size(): the environment). False only where every

@@ -9,6 +9,7 @@
 #include "transport/media_point.h"
 #include "transport/path_guide.h"
 #include "transport/roulette.h"
+#include "transport/sphere_caustics.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
 
@@ -39,6 +40,25 @@ float probeLength(ThreadContext& ctx, int region, int channel, const PathState& 
     const float sigmaT = trackedSigmaT(r.unboundedSigmaT, channel);
     if (!(sigmaT > 0) || regionHasLightDistances(ctx, region, st.pointLightsByPhotons)) return Infinity;
     return ProbeFreePaths / sigmaT;
+}
+
+// A new vertex at x from which the path samples its next direction: sphere
+// caustic connections (made there when `caustics`) start a new pattern.
+void startVertex(PathState& st, const Vec3& x, const Vec3& wi, float pdf, bool caustics) {
+    st.lastPdf = pdf;
+    st.lastDir = wi;
+    st.specular = false;
+    st.lastPoint = x;
+    st.causticsAtLast = caustics;
+    st.lensSphere = -1;
+    st.lensRefractions = 0;
+}
+
+// The glass sphere (Scene::glassSpheres) of surface `surface`, or -1.
+int glassSphereOf(const Scene& scene, int surface) {
+    for (size_t i = 0; i < scene.glassSpheres.size(); ++i)
+        if (scene.glassSpheres[i].surface == surface) return int(i);
+    return -1;
 }
 
 // Russian roulette on the throughput after RouletteMinDepth events.
@@ -131,6 +151,10 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
             add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, weights)), st.depth);
+            const bool caustics = regionHasSphereCaustics(scene, region);
+            if (caustics)
+                add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching),
+                    st.depth);
             // Guided roulette and splitting of what follows the vertex.
             int paths = 1;
             if (st.windowReference > 0) {
@@ -163,9 +187,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             }
             float pdf = 0;
             const Vec3 wi = sampleDirection(beta, pdf);
-            st.lastPdf = pdf;
-            st.specular = false;
-            st.lastPoint = x;
+            startVertex(st, x, wi, pdf, caustics);
             ray = Ray{x, wi};
             return true;
         };
@@ -204,6 +226,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const SplitCopy& c = copies[size_t(k)];
             PathState cs = st;
             cs.lastPdf = c.pdf;
+            cs.lastDir = c.ray.d;
             const PathRadiance r = tracePath(ctx, c.ray, region, channel, rng, cs);
             L += c.beta * r.L;
             direct += c.beta * r.direct;
@@ -227,6 +250,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 float d2 = lengthSquared(to), r2 = l.desc().radius * l.desc().radius;
                 float sin2 = r2 / d2, cosMax = sin2 < 1e-6f ? 1 - 0.5f * sin2 : safeSqrt(1 - sin2);
                 w = powerHeuristic(st.lastPdf, uniformConePdf(cosMax));
+            } else if (st.causticsAtLast && st.lensRefractions == 2) {
+                // Through a glass sphere, which sphere caustic connections
+                // at lastPoint also follow.
+                w = sphereCausticPathWeight(scene, st.lensSphere, light, st.lastPoint, st.lastDir, st.lastPdf,
+                                            ray.at(tEnd));
             }
             add(beta * l.emittedRadiance() * w, st.depth);
             return result(0.f);
@@ -247,14 +275,23 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             if (++st.depth > maxDepth) return result(0.f);
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            add(beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng,
-                                   nextEventOptions(st)),
-                st.depth);
-            st.lastPdf = e.pdf;
-            st.specular = false;
-            st.lastPoint = h.p;
+            const ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
+            add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st)), st.depth);
+            const bool caustics = regionHasSphereCaustics(scene, region);
+            if (caustics)
+                add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching),
+                    st.depth);
+            startVertex(st, h.p, e.ray.d, e.pdf, caustics);
         } else if (!e.straight) {
             st.specular = true;  // next-event estimation cannot see through this
+            // Two refractions through one glass sphere keep the pattern of
+            // a sphere caustic connection; anything else breaks it.
+            const int sphere = e.kind == SurfaceEvent::Kind::Refract ? glassSphereOf(scene, h.surface) : -1;
+            if (sphere < 0 || (st.lensSphere >= 0 && st.lensSphere != sphere)) st.lensRefractions = -1;
+            else if (st.lensRefractions >= 0) {
+                st.lensSphere = sphere;
+                ++st.lensRefractions;
+            }
         }
         beta *= e.weight;
         ray = e.ray;

@@ -47,6 +47,15 @@ struct PathState {
     // split into.
     float windowReference = 0;
     int splitLimit = MaxSplitPaths;
+    // Sphere caustic connections (sphere_caustics.h) were made at lastPoint,
+    // and the refractions since then through one glass sphere: a sphere
+    // light hit after exactly two (in and out) takes the MIS weight against
+    // them. -1 in lensSphere: none yet; lensRefractions < 0: another event
+    // broke the pattern.
+    bool causticsAtLast = false;
+    Vec3 lastDir{0, 0, 1};  // the direction sampled at lastPoint
+    int lensSphere = -1;
+    int lensRefractions = 0;
 };
 
 // What a path brings back: a camera path's result (Estimator::radiance) and a

@@ -1,0 +1,319 @@
+#include "transport/sphere_caustics.h"
+
+#include <cmath>
+
+#include "core/sampling.h"
+#include "transport/surface_event.h"
+
+namespace vdbmarch {
+
+namespace {
+
+// Double-precision vectors: the roots and the spreading's central
+// differences need more digits than float keeps.
+struct D3 {
+    double x = 0, y = 0, z = 0;
+    D3() = default;
+    D3(double a, double b, double c) : x(a), y(b), z(c) {}
+    explicit D3(const Vec3& v) : x(v.x), y(v.y), z(v.z) {}
+    D3 operator+(const D3& o) const { return {x + o.x, y + o.y, z + o.z}; }
+    D3 operator-(const D3& o) const { return {x - o.x, y - o.y, z - o.z}; }
+    D3 operator*(double s) const { return {x * s, y * s, z * s}; }
+    Vec3 f() const { return Vec3(float(x), float(y), float(z)); }
+};
+double dot(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+D3 cross(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double length(const D3& a) { return std::sqrt(dot(a, a)); }
+D3 normalize(const D3& a) { return a * (1 / length(a)); }
+
+// Refraction of unit d at unit normal n facing the arriving ray, eta =
+// n_transmitted / n_incident; F the Fresnel reflectance (core/sampling.h's
+// formula). False on total internal reflection.
+bool refract(const D3& d, const D3& n, double eta, D3& t, double& F) {
+    const double cosI = std::min(1.0, std::max(0.0, -dot(d, n)));
+    const double sin2T = (1 - cosI * cosI) / (eta * eta);
+    if (sin2T >= 1) return false;
+    const double cosT = std::sqrt(1 - sin2T);
+    const double rPar = (eta * cosI - cosT) / (eta * cosI + cosT);
+    const double rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
+    F = 0.5 * (rPar * rPar + rPerp * rPerp);
+    t = normalize(d * (1 / eta) + n * (cosI / eta - cosT));
+    return true;
+}
+
+struct Traced {
+    D3 p1, p2, wo;
+    double transmission = 0;
+};
+
+// The ray x + t w into sphere s and out again.
+bool trace(const GlassSphere& s, const D3& x, const D3& w, Traced& out) {
+    const D3 c(s.center);
+    const double R = s.radius;
+    const D3 oc = x - c;
+    const double b = dot(w, oc), cc = dot(oc, oc) - R * R;
+    const double disc = b * b - cc;
+    if (!(cc > 0) || !(disc > 0) || !(b < 0)) return false;  // inside, missed, or behind
+    const double t1 = -b - std::sqrt(disc);
+    out.p1 = x + w * t1;
+    const D3 n1 = (out.p1 - c) * (1 / R);
+    D3 d1;
+    double F1, F2;
+    if (!refract(w, n1, s.ior, d1, F1)) return false;
+    // The chord along d1 from p1 (|p1 - c| = R).
+    const double chord = -2 * dot(out.p1 - c, d1);
+    if (!(chord > 0)) return false;
+    out.p2 = out.p1 + d1 * chord;
+    const D3 n2 = (out.p2 - c) * (1 / R);
+    if (!refract(d1, n2 * -1.0, 1 / double(s.ior), out.wo, F2)) return false;
+    out.transmission = (1 - F1) * (1 - F2);
+    return true;
+}
+
+// Bracketing grid over the outline's arc that x sees, and refinement steps.
+constexpr int RootGrid = 32;
+constexpr int RootIterations = 40;
+
+// A direction from x matches a root when within about 1.4e-3 rad of it.
+constexpr double RootMatchCos = 1 - 1e-6;
+
+double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y) {
+    // The exit ray of w perturbed by (u, v) in a tangent frame, met with the
+    // plane through y perpendicular to the exit direction.
+    Traced base;
+    if (!trace(s, x, w, base)) return 0;
+    const D3 helper = std::fabs(w.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0);
+    const D3 t1 = normalize(cross(w, helper)), t2 = cross(w, t1);
+    const double eps = 1e-6;
+    D3 q[4];
+    const double du[4] = {eps, -eps, 0, 0}, dv[4] = {0, 0, eps, -eps};
+    for (int k = 0; k < 4; ++k) {
+        Traced tr;
+        if (!trace(s, x, normalize(w + t1 * du[k] + t2 * dv[k]), tr)) return 0;
+        const double den = dot(tr.wo, base.wo);
+        if (!(den > 0)) return 0;
+        q[k] = tr.p2 + tr.wo * (dot(y - tr.p2, base.wo) / den);
+    }
+    const D3 qu = (q[0] - q[1]) * (0.5 / eps), qv = (q[2] - q[3]) * (0.5 / eps);
+    return length(cross(qu, qv));
+}
+
+SphereConnection toConnection(const D3& w, const Traced& tr, double G) {
+    SphereConnection c;
+    c.wi = w.f();
+    c.p1 = tr.p1.f();
+    c.p2 = tr.p2.f();
+    c.wo = tr.wo.f();
+    c.transmission = float(tr.transmission);
+    c.spreading = G;
+    return c;
+}
+
+// The glass sphere a sphere light can be reached through: outside it.
+bool lightOutside(const GlassSphere& s, const Light& l) {
+    return l.isSphere() && length(l.desc().position - s.center) > s.radius + l.desc().radius;
+}
+
+}  // namespace
+
+bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out) {
+    Traced tr;
+    const D3 wd = normalize(D3(w));
+    if (!trace(s, D3(x), wd, tr)) return false;
+    out = toConnection(wd, tr, 0);
+    return true;
+}
+
+double sphereRaySpreading(const GlassSphere& s, const Vec3& x, const Vec3& w, const Vec3& y) {
+    return spreading(s, D3(x), normalize(D3(w)), D3(y));
+}
+
+int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, SphereConnection out[MaxSphereConnections]) {
+    const D3 c(s.center), x(xf), y(yf);
+    const double R = s.radius;
+    const D3 cx = x - c;
+    const double dx = length(cx);
+    if (!(dx > R * (1 + 1e-6))) return 0;
+    // The plane of x, y and the centre: e1 towards x, e2 towards y's side.
+    const D3 e1 = cx * (1 / dx);
+    const D3 cy = y - c;
+    const D3 yPerp = cy - e1 * dot(cy, e1);
+    const double yh = length(yPerp);
+    if (!(yh > 1e-9 * (R + length(cy)))) return 0;  // y on the axis: a ring of paths, measure zero
+    const D3 e2 = yPerp * (1 / yh), e3 = cross(e1, e2);
+    // Directions to the outline point at angle a from e1; the visible arc is
+    // |a| < acos(R / dx).
+    const double aMax = std::acos(R / dx);
+    auto direction = [&](double a) {
+        return normalize(c + (e1 * std::cos(a) + e2 * std::sin(a)) * R - x);
+    };
+    // In the plane, with the centre at the origin: x = (dx, 0), y = (y1, y2).
+    const double y1 = dot(cy, e1), y2 = yh, eta = s.ior;
+    // h(a): which side of the exit ray y lies (0 on a root), and how far
+    // ahead of the exit point, from the outline point (cos a, sin a) R. The
+    // two refractions in closed form: inside, the angle to the normal is
+    // theta_t at both ends, so the exit's transmitted cosine is cos theta_i.
+    struct Eval {
+        bool ok = false;
+        double h = 0, ahead = 0;
+    };
+    auto evalCS = [&](double ca, double sa) {
+        Eval e;
+        const double px = R * ca - dx, py = R * sa;  // p1 - x
+        const double inv = 1 / std::sqrt(px * px + py * py);
+        const double d0x = px * inv, d0y = py * inv;
+        const double cosI = -(d0x * ca + d0y * sa);
+        if (!(cosI > 0)) return e;
+        const double sin2T = (1 - cosI * cosI) / (eta * eta);
+        const double cosT = std::sqrt(1 - sin2T);
+        const double k1 = cosI / eta - cosT;
+        const double d1x = d0x / eta + ca * k1, d1y = d0y / eta + sa * k1;
+        const double chord = -2 * R * (ca * d1x + sa * d1y);
+        if (!(chord > 0)) return e;
+        const double p2x = R * ca + d1x * chord, p2y = R * sa + d1y * chord;
+        const double k2 = (eta * cosT - cosI) / R;  // n2 = p2 / R
+        const double d2x = eta * d1x - p2x * k2, d2y = eta * d1y - p2y * k2;
+        const double tx = y1 - p2x, ty = y2 - p2y;
+        e.ok = true;
+        e.h = d2x * ty - d2y * tx;
+        e.ahead = d2x * tx + d2y * ty;
+        return e;
+    };
+    auto eval = [&](double a) { return evalCS(std::cos(a), std::sin(a)); };
+    int n = 0;
+    double aPrev = 0;
+    Eval prev;
+    // The grid's angles by rotation: one sincos for the whole grid.
+    const double step = 2 * aMax / RootGrid, a0 = -aMax + 0.5 * step;
+    const double cStep = std::cos(step), sStep = std::sin(step);
+    double ca = std::cos(a0), sa = std::sin(a0);
+    for (int k = 0; k < RootGrid && n < MaxSphereConnections; ++k) {
+        const double a = a0 + k * step;
+        const Eval cur = evalCS(ca, sa);
+        const double cNext = ca * cStep - sa * sStep;
+        sa = sa * cStep + ca * sStep;
+        ca = cNext;
+        if (k > 0 && prev.ok && cur.ok && (prev.h < 0) != (cur.h < 0)) {
+            // False position with the Illinois modification: the bracket
+            // stays, convergence is superlinear.
+            double lo = aPrev, hi = a, hLo = prev.h, hHi = cur.h;
+            int side = 0;
+            double root = lo;
+            for (int i = 0; i < RootIterations; ++i) {
+                root = (lo * hHi - hi * hLo) / (hHi - hLo);
+                if (!(root > std::min(lo, hi) && root < std::max(lo, hi))) root = 0.5 * (lo + hi);
+                const Eval m = eval(root);
+                if (!m.ok) break;
+                if (std::fabs(m.h) < 1e-12 * (1 + std::fabs(m.ahead)) || std::fabs(hi - lo) < 1e-13) break;
+                if ((m.h < 0) == (hLo < 0)) {
+                    lo = root;
+                    hLo = m.h;
+                    if (side == -1) hHi *= 0.5;
+                    side = -1;
+                } else {
+                    hi = root;
+                    hHi = m.h;
+                    if (side == 1) hLo *= 0.5;
+                    side = 1;
+                }
+            }
+            const Eval r = eval(root);
+            // A sign change behind the exit point is no connection.
+            Traced tr;
+            const D3 w = direction(root);
+            if (r.ok && r.ahead > 0 && trace(s, x, w, tr) && std::fabs(r.h) < 1e-6 * length(y - tr.p2))
+                out[n++] = toConnection(w, tr, spreading(s, x, w, y));
+        }
+        prev = cur;
+        aPrev = a;
+    }
+    return n;
+}
+
+bool regionHasSphereCaustics(const Scene& scene, int region) {
+    if (!scene.hasSphereLights || !scene.desc.render.sphereCaustics) return false;
+    for (const GlassSphere& s : scene.glassSpheres)
+        if (s.outside == region) return true;
+    return false;
+}
+
+Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
+                         TransmittanceEstimator estimator) {
+    const Scene& scene = ctx.scene;
+    Color L(0);
+    Vec3 origin = v.p;
+    if (!v.phase) {  // leave the surface on the side the path arrived from
+        const Vec3 nf = dot(v.n, v.d) < 0 ? v.n : -v.n;
+        origin = v.p + nf * (1e-5f * std::max(scene.sceneScale, maxComponent(max(v.p, -v.p))));
+    }
+    SphereConnection roots[MaxSphereConnections];
+    for (const GlassSphere& s : scene.glassSpheres) {
+        if (s.outside != region) continue;
+        for (const Light& light : scene.lights) {
+            if (!lightOutside(s, light)) continue;
+            // y uniform on the light's surface.
+            const float rl = light.desc().radius;
+            const Vec3 ny = sampleUniformSphere(rng.uniform(), rng.uniform());
+            const Vec3 y = light.desc().position + ny * rl;
+            const double pA = 1 / (4 * double(Pi) * double(rl) * double(rl));
+            const int n = connectThroughSphere(s, v.p, y, roots);
+            for (int k = 0; k < n; ++k) {
+                const SphereConnection& cn = roots[k];
+                const double cosY = -double(dot(cn.wo, ny));
+                if (!(cosY > 0) || !(cn.spreading > 0)) continue;  // the light's far side
+                const Color f = v.f(cn.wi);
+                if (isBlack(f)) continue;
+                // x -> p1: nothing in the way but media.
+                const float d1 = length(cn.p1 - origin);
+                Color T = shadowTransmittance(ctx, region, origin, cn.wi, d1, rng, estimator);
+                if (isBlack(T)) continue;
+                const Vec3 n2 = normalize(cn.p2 - s.center);
+                if (!s.clearInside) {
+                    const Vec3 n1 = normalize(cn.p1 - s.center);
+                    const Vec3 d = normalize(cn.p2 - cn.p1);
+                    SurfaceHit h;
+                    const Ray inside{offsetRayOrigin(scene, cn.p1, n1, d), d};
+                    if (scene.surfaceSet->intersect(inside, 0.f, length(cn.p2 - inside.o) * (1 - 1e-4f), h)) continue;
+                }
+                // p2 -> y: the light's own surface ends the shadow ray.
+                const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
+                T *= shadowTransmittance(ctx, s.outside, o2, cn.wo, length(y - o2), rng, estimator);
+                if (isBlack(T)) continue;
+                const double pm = pA * cn.spreading / cosY;  // solid-angle density at x
+                const double pu = double(v.pdf(cn.wi)) * double(cn.transmission);
+                const double w = pm * pm / (pm * pm + pu * pu);
+                L += f * light.emittedRadiance() * T * float(double(cn.transmission) * w / pm);
+            }
+        }
+    }
+    return L;
+}
+
+float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const Vec3& x, const Vec3& w, float pathPdf,
+                              const Vec3& y) {
+    const GlassSphere& s = scene.glassSpheres[size_t(sphere)];
+    const Light& l = scene.lights[size_t(light)];
+    if (!lightOutside(s, l)) return 1;
+    SphereConnection roots[MaxSphereConnections];
+    const int n = connectThroughSphere(s, x, y, roots);
+    int best = -1;
+    double bestCos = RootMatchCos;
+    for (int k = 0; k < n; ++k) {
+        const double c = double(dot(roots[k].wi, normalize(w)));
+        if (c > bestCos) {
+            bestCos = c;
+            best = k;
+        }
+    }
+    if (best < 0) return 1;  // connections from x would not find this path
+    const SphereConnection& cn = roots[best];
+    const Vec3 ny = normalize(y - l.desc().position);
+    const double cosY = -double(dot(cn.wo, ny));
+    if (!(cosY > 0) || !(cn.spreading > 0)) return 1;
+    const double rl = l.desc().radius;
+    const double pm = cn.spreading / (4 * double(Pi) * rl * rl * cosY);
+    const double pu = double(pathPdf) * double(cn.transmission);
+    return float(pu * pu / (pu * pu + pm * pm));
+}
+
+}  // namespace vdbmarch

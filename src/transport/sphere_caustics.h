@@ -1,0 +1,80 @@
+// Next-event estimation through a smooth glass sphere: the light a lens
+// focuses into a medium or onto a diffuse floor (a caustic), which ordinary
+// shadow rays cannot follow (glass blocks them) and a path finds only when
+// its sampled direction happens to refract into the light.
+//
+// This is manifold next-event estimation (Hanika, Droske and Fascione 2015,
+// "Manifold Next Event Estimation"; Cycles' shadow caustics) for the case a
+// sphere makes exact: a path x -> p1 (enters) -> p2 (leaves) -> y refracts in
+// the plane through x, y and the sphere's centre (each refraction keeps the
+// ray in the plane of the incident direction and the normal), so the
+// connections from x to a light point y are the roots of a function of one
+// angle on the sphere's outline in that plane. They are bracketed on a fixed
+// grid and refined by bisection, deterministically in (x, y).
+//
+// The estimate for each root, with y drawn on the light with area density
+// p_A (a sphere light; delta lights have y fixed):
+//   f(w) L_e T (1 - F1)(1 - F2) |cos theta_y| / (p_A G),
+// G = dA_perp(y) / d omega(x), the ray spreading through the lens (the
+// generalised geometry term; r^2 without glass), by central differences of
+// the traced rays in double precision. Its solid-angle density at x is
+// p_m = p_A G / |cos theta_y|.
+//
+// A path that samples its direction at x (density p_u, times the Fresnel
+// transmission choices) and reaches a sphere light through the same two
+// refractions is the other way to the same light; the two are weighed by
+// the power heuristic on (p_u, p_m). The path's side finds its p_m by
+// solving from (x, y) with the same solver and matching its direction to a
+// root: when no root matches (the grid missed a pair of roots at a fold),
+// the path keeps weight 1, so the sum is unbiased whatever the solver finds.
+#pragma once
+
+#include "core/rng.h"
+#include "scene/scene.h"
+#include "transport/direct_light.h"
+
+namespace vdbmarch {
+
+// A connection from x through a glass sphere to a point y.
+struct SphereConnection {
+    Vec3 wi;             // unit, from x to the entry point p1
+    Vec3 p1, p2;         // entry and exit points
+    Vec3 wo;             // unit, from p2 towards y
+    float transmission;  // (1 - F1)(1 - F2), the Fresnel transmittances
+    double spreading;    // G = dA_perp(y) / d omega(x)
+};
+
+// Most connections one (x, y) pair can have through a sphere.
+constexpr int MaxSphereConnections = 8;
+
+// Every connection from x to y through sphere s that the solver finds (x and
+// y outside it); returns their number.
+int connectThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections]);
+
+// Traces direction w from x into sphere s and out again (double precision):
+// the exit point and direction, the Fresnel transmittances. False when the
+// ray misses the sphere.
+bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out);
+
+// G for the path leaving x along w through s, measured at the plane through
+// y perpendicular to the exit direction.
+double sphereRaySpreading(const GlassSphere& s, const Vec3& x, const Vec3& w, const Vec3& y);
+
+// The caustic light at vertex v (in `region`) from every sphere light
+// through every glass sphere, one light point each, weighed against the
+// path's own hits of sphere lights (sphereCausticPathWeight).
+Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
+                         TransmittanceEstimator estimator);
+
+// The power-heuristic weight of a path that left x along w (its direction
+// density pathPdf), refracted into and out of glass sphere `sphere` and hit
+// sphere light `light` at y: 1 when connections from x would not have found
+// this path.
+float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const Vec3& x, const Vec3& w, float pathPdf,
+                              const Vec3& y);
+
+// True when sphere caustic connections apply at a vertex in `region`
+// (render.sphere_caustics, a sphere light, a glass sphere around the region).
+bool regionHasSphereCaustics(const Scene& scene, int region);
+
+}  // namespace vdbmarch
