@@ -237,6 +237,47 @@ bool regionHasSphereCaustics(const Scene& scene, int region) {
     return false;
 }
 
+namespace {
+
+// The pdf of directions uniform in the cone that sphere s subtends from x.
+double ballConePdf(const GlassSphere& s, const Vec3& x) {
+    const double d2 = double(lengthSquared(s.center - x)), r2 = double(s.radius) * double(s.radius);
+    if (!(d2 > r2)) return 0;
+    const double sin2 = r2 / d2, oneMinusCos = sin2 / (1 + std::sqrt(1 - sin2));
+    return 1 / (2 * double(Pi) * oneMinusCos);
+}
+
+// The connections' density over directions at x of the path through s along
+// w that reaches y on light l: 0 when the solver from (x, y) finds no root
+// matching w.
+double connectionPdf(const GlassSphere& s, const Light& l, const Vec3& x, const Vec3& w, const Vec3& y) {
+    SphereConnection roots[MaxSphereConnections];
+    const int n = connectThroughSphere(s, x, y, roots);
+    int best = -1;
+    double bestCos = RootMatchCos;
+    for (int k = 0; k < n; ++k) {
+        const double c = double(dot(roots[k].wi, w));
+        if (c > bestCos) {
+            bestCos = c;
+            best = k;
+        }
+    }
+    if (best < 0) return 0;
+    const SphereConnection& cn = roots[best];
+    const double cosY = -double(dot(cn.wo, normalize(y - l.desc().position)));
+    if (!(cosY > 0) || !(cn.spreading > 0)) return 0;
+    const double rl = l.desc().radius;
+    return cn.spreading / (4 * double(Pi) * rl * rl * cosY);
+}
+
+// Power heuristic of density a among a, b and c.
+double power3(double a, double b, double c) {
+    const double a2 = a * a, sum = a2 + b * b + c * c;
+    return sum > 0 ? a2 / sum : 0.0;
+}
+
+}  // namespace
+
 Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
                          TransmittanceEstimator estimator) {
     const Scene& scene = ctx.scene;
@@ -249,12 +290,32 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
     SphereConnection roots[MaxSphereConnections];
     for (const GlassSphere& s : scene.glassSpheres) {
         if (s.outside != region) continue;
+        const double pc = ballConePdf(s, v.p);
+        if (!(pc > 0)) continue;
+        // What reaches x from y through the ball along the connection cn:
+        // transmittance x -> p1, nothing inside the ball, p2 -> y.
+        auto throughBall = [&](const SphereConnection& cn, const Vec3& y) {
+            const float d1 = length(cn.p1 - origin);
+            Color T = shadowTransmittance(ctx, region, origin, cn.wi, d1, rng, estimator);
+            if (isBlack(T)) return T;
+            if (!s.clearInside) {
+                const Vec3 n1 = normalize(cn.p1 - s.center);
+                const Vec3 d = normalize(cn.p2 - cn.p1);
+                SurfaceHit h;
+                const Ray inside{offsetRayOrigin(scene, cn.p1, n1, d), d};
+                if (scene.surfaceSet->intersect(inside, 0.f, length(cn.p2 - inside.o) * (1 - 1e-4f), h)) return Color(0);
+            }
+            // p2 -> y: the light's own surface ends the shadow ray.
+            const Vec3 o2 = offsetRayOrigin(scene, cn.p2, normalize(cn.p2 - s.center), cn.wo);
+            return T * shadowTransmittance(ctx, s.outside, o2, cn.wo, length(y - o2), rng, estimator);
+        };
         for (const Light& light : scene.lights) {
             if (!lightOutside(s, light)) continue;
-            // y uniform on the light's surface.
+            const Vec3 lc = light.desc().position;
             const float rl = light.desc().radius;
+            // 1. Connections: y uniform on the light's surface.
             const Vec3 ny = sampleUniformSphere(rng.uniform(), rng.uniform());
-            const Vec3 y = light.desc().position + ny * rl;
+            const Vec3 y = lc + ny * rl;
             const double pA = 1 / (4 * double(Pi) * double(rl) * double(rl));
             const int n = connectThroughSphere(s, v.p, y, roots);
             for (int k = 0; k < n; ++k) {
@@ -263,27 +324,31 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                 if (!(cosY > 0) || !(cn.spreading > 0)) continue;  // the light's far side
                 const Color f = v.f(cn.wi);
                 if (isBlack(f)) continue;
-                // x -> p1: nothing in the way but media.
-                const float d1 = length(cn.p1 - origin);
-                Color T = shadowTransmittance(ctx, region, origin, cn.wi, d1, rng, estimator);
-                if (isBlack(T)) continue;
-                const Vec3 n2 = normalize(cn.p2 - s.center);
-                if (!s.clearInside) {
-                    const Vec3 n1 = normalize(cn.p1 - s.center);
-                    const Vec3 d = normalize(cn.p2 - cn.p1);
-                    SurfaceHit h;
-                    const Ray inside{offsetRayOrigin(scene, cn.p1, n1, d), d};
-                    if (scene.surfaceSet->intersect(inside, 0.f, length(cn.p2 - inside.o) * (1 - 1e-4f), h)) continue;
-                }
-                // p2 -> y: the light's own surface ends the shadow ray.
-                const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
-                T *= shadowTransmittance(ctx, s.outside, o2, cn.wo, length(y - o2), rng, estimator);
+                const Color T = throughBall(cn, y);
                 if (isBlack(T)) continue;
                 const double pm = pA * cn.spreading / cosY;  // solid-angle density at x
                 const double pu = double(v.pdf(cn.wi)) * double(cn.transmission);
-                const double w = pm * pm / (pm * pm + pu * pu);
-                L += f * light.emittedRadiance() * T * float(double(cn.transmission) * w / pm);
+                L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pm, pu, pc) / pm);
             }
+            // 2. A direction uniform in the ball's cone, traced through it:
+            // where the lens focuses the light (G near 0), the light fills
+            // much of the ball and this finds it where connections cannot.
+            SphereConnection cn;
+            const Vec3 axis = normalize(s.center - v.p);
+            const float cosMax = float(1 - 1 / (2 * double(Pi) * pc));
+            const Vec3 w = sampleUniformCone(axis, cosMax, rng.uniform(), rng.uniform());
+            if (!traceThroughSphere(s, v.p, w, cn)) continue;
+            const Vec3 oc = cn.p2 - lc;
+            const float b = dot(cn.wo, oc), c = dot(oc, oc) - rl * rl, disc = b * b - c;
+            if (!(c > 0) || !(b < 0) || !(disc > 0)) continue;  // misses the light
+            const Color f = v.f(cn.wi);
+            if (isBlack(f)) continue;
+            const Vec3 yHit = cn.p2 + cn.wo * (-b - std::sqrt(disc));
+            const Color T = throughBall(cn, yHit);
+            if (isBlack(T)) continue;
+            const double pm = connectionPdf(s, light, v.p, cn.wi, yHit);
+            const double pu = double(v.pdf(cn.wi)) * double(cn.transmission);
+            L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pc, pm, pu) / pc);
         }
     }
     return L;
@@ -294,26 +359,11 @@ float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const V
     const GlassSphere& s = scene.glassSpheres[size_t(sphere)];
     const Light& l = scene.lights[size_t(light)];
     if (!lightOutside(s, l)) return 1;
-    SphereConnection roots[MaxSphereConnections];
-    const int n = connectThroughSphere(s, x, y, roots);
-    int best = -1;
-    double bestCos = RootMatchCos;
-    for (int k = 0; k < n; ++k) {
-        const double c = double(dot(roots[k].wi, normalize(w)));
-        if (c > bestCos) {
-            bestCos = c;
-            best = k;
-        }
-    }
-    if (best < 0) return 1;  // connections from x would not find this path
-    const SphereConnection& cn = roots[best];
-    const Vec3 ny = normalize(y - l.desc().position);
-    const double cosY = -double(dot(cn.wo, ny));
-    if (!(cosY > 0) || !(cn.spreading > 0)) return 1;
-    const double rl = l.desc().radius;
-    const double pm = cn.spreading / (4 * double(Pi) * rl * rl * cosY);
-    const double pu = double(pathPdf) * double(cn.transmission);
-    return float(pu * pu / (pu * pu + pm * pm));
+    const Vec3 wn = normalize(w);
+    SphereConnection traced;
+    if (!traceThroughSphere(s, x, wn, traced)) return 1;
+    const double pu = double(pathPdf) * double(traced.transmission);
+    return float(power3(pu, connectionPdf(s, l, x, wn, y), ballConePdf(s, x)));
 }
 
 }  // namespace vdbmarch

@@ -32,6 +32,16 @@ TEST(SphereCausticRenders, FogAndFloorUnderAGlassBallAgreeWithPathsAlone) {
     expectPairedAgreement(off, on, "fig4_caustic_sphere");
 }
 
+TEST(SphereCausticRenders, ALargeLightThatPathsFindOftenAgreesWithPathsAlone) {
+    // A light the paths find often through the ball: every technique's
+    // share counts (connections, directions towards the ball, the paths).
+    std::vector<std::string> o = CausticScene;
+    o.push_back(R"(lights=[{"type": "sphere", "position": [0, 2.2, 0], "radius": 0.5, "power": [300, 290, 270]}])");
+    const Image on = renderWith("scenes/fig4_caustic_sphere.json", o, true);
+    const Image off = renderWith("scenes/fig4_caustic_sphere.json", o, false);
+    expectPairedAgreement(off, on, "a large light over the ball");
+}
+
 TEST(SphereCausticRenders, GuidedMarcherAgreesWithItsPathsAlone) {
     // The marcher's L_i samples connect too (li = "path"), and its
     // continuation paths weigh their hits against that.
