@@ -71,31 +71,35 @@ bool trace(const GlassSphere& s, const D3& x, const D3& w, Traced& out) {
 }
 
 // Bracketing grid over the outline's arc that x sees, and refinement steps.
-constexpr int RootGrid = 32;
+constexpr int RootGrid = 24;
 constexpr int RootIterations = 40;
 
 // A direction from x matches a root when within about 1.4e-3 rad of it.
 constexpr double RootMatchCos = 1 - 1e-6;
 
-double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y) {
+// G by forward differences from the traced path `base` of w (their error,
+// O(eps) relative, is far below the noise of any estimate).
+double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y, const Traced& base) {
     // The exit ray of w perturbed by (u, v) in a tangent frame, met with the
     // plane through y perpendicular to the exit direction.
-    Traced base;
-    if (!trace(s, x, w, base)) return 0;
     const D3 helper = std::fabs(w.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0);
     const D3 t1 = normalize(cross(w, helper)), t2 = cross(w, t1);
     const double eps = 1e-6;
-    D3 q[4];
-    const double du[4] = {eps, -eps, 0, 0}, dv[4] = {0, 0, eps, -eps};
-    for (int k = 0; k < 4; ++k) {
+    D3 q[2];
+    for (int k = 0; k < 2; ++k) {
         Traced tr;
-        if (!trace(s, x, normalize(w + t1 * du[k] + t2 * dv[k]), tr)) return 0;
+        if (!trace(s, x, normalize(w + (k == 0 ? t1 : t2) * eps), tr)) return 0;
         const double den = dot(tr.wo, base.wo);
         if (!(den > 0)) return 0;
         q[k] = tr.p2 + tr.wo * (dot(y - tr.p2, base.wo) / den);
     }
-    const D3 qu = (q[0] - q[1]) * (0.5 / eps), qv = (q[2] - q[3]) * (0.5 / eps);
-    return length(cross(qu, qv));
+    const D3 q0 = base.p2 + base.wo * dot(y - base.p2, base.wo);
+    return length(cross(q[0] - q0, q[1] - q0)) / (eps * eps);
+}
+
+double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y) {
+    Traced base;
+    return trace(s, x, w, base) ? spreading(s, x, w, y, base) : 0;
 }
 
 SphereConnection toConnection(const D3& w, const Traced& tr, double G) {
@@ -222,7 +226,7 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
             Traced tr;
             const D3 w = direction(root);
             if (r.ok && r.ahead > 0 && trace(s, x, w, tr) && std::fabs(r.h) < 1e-6 * length(y - tr.p2))
-                out[n++] = toConnection(w, tr, spreading(s, x, w, y));
+                out[n++] = toConnection(w, tr, spreading(s, x, w, y, tr));
         }
         prev = cur;
         aPrev = a;
