@@ -10,23 +10,26 @@
 // ray in the plane of the incident direction and the normal), so the
 // connections from x to a light point y are the roots of a function of one
 // angle on the sphere's outline in that plane. They are bracketed on a fixed
-// grid and refined by bisection, deterministically in (x, y).
+// grid and refined by false position, deterministically in (x, y).
 //
 // The estimate for each root, with y drawn on the light with area density
-// p_A (a sphere light; delta lights have y fixed):
+// p_A (sphere lights):
 //   f(w) L_e T (1 - F1)(1 - F2) |cos theta_y| / (p_A G),
 // G = dA_perp(y) / d omega(x), the ray spreading through the lens (the
-// generalised geometry term; r^2 without glass), by central differences of
+// generalised geometry term; r^2 without glass), by forward differences of
 // the traced rays in double precision. Its solid-angle density at x is
 // p_m = p_A G / |cos theta_y|.
 //
-// A path that samples its direction at x (density p_u, times the Fresnel
-// transmission choices) and reaches a sphere light through the same two
-// refractions is the other way to the same light; the two are weighed by
-// the power heuristic on (p_u, p_m). The path's side finds its p_m by
-// solving from (x, y) with the same solver and matching its direction to a
-// root: when no root matches (the grid missed a pair of roots at a fold),
-// the path keeps weight 1, so the sum is unbiased whatever the solver finds.
+// Near the lens's focus G goes to 0 and these estimates grow without bound;
+// there a direction drawn uniformly in the cone the ball subtends (density
+// p_c), traced through it, finds the light often. A path that samples its
+// own direction at x (density p_u, times the Fresnel transmission choices)
+// and reaches the light through the same two refractions is the third way
+// to the same light; the three are weighed by the power heuristic. The
+// path's and the cone's side find p_m by solving from (x, y) with the same
+// solver and matching their direction to a root, 0 when none matches (the
+// grid missed a pair of roots at a fold), so the weights sum to 1 whatever
+// the solver finds.
 #pragma once
 
 #include "core/rng.h"
@@ -61,15 +64,16 @@ bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, Sphe
 double sphereRaySpreading(const GlassSphere& s, const Vec3& x, const Vec3& w, const Vec3& y);
 
 // The caustic light at vertex v (in `region`) from every sphere light
-// through every glass sphere, one light point each, weighed against the
+// through every glass sphere: the connections to one light point and one
+// direction in the ball's cone, each weighed against the other and the
 // path's own hits of sphere lights (sphereCausticPathWeight).
 Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
                          TransmittanceEstimator estimator);
 
 // The power-heuristic weight of a path that left x along w (its direction
 // density pathPdf), refracted into and out of glass sphere `sphere` and hit
-// sphere light `light` at y: 1 when connections from x would not have found
-// this path.
+// sphere light `light` at y, against the connections and the cone
+// directions at x (sphereCausticLight).
 float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const Vec3& x, const Vec3& w, float pathPdf,
                               const Vec3& y);
 
