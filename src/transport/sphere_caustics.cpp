@@ -243,11 +243,17 @@ bool regionHasSphereCaustics(const Scene& scene, int region) {
 
 namespace {
 
-// The pdf of directions uniform in the cone that sphere s subtends from x.
-double ballConePdf(const GlassSphere& s, const Vec3& x) {
+// The pdf of directions uniform in the cone that sphere s subtends from x
+// (and the cone's cosine). 0 where x is inside, or where the ball is too
+// small to sample its cone in float (1 - cos below 1e-6, a ball thousands
+// of radii away): then no side counts cone directions, so the weights
+// still sum to 1.
+double ballConePdf(const GlassSphere& s, const Vec3& x, float* cosMax = nullptr) {
     const double d2 = double(lengthSquared(s.center - x)), r2 = double(s.radius) * double(s.radius);
     if (!(d2 > r2)) return 0;
     const double sin2 = r2 / d2, oneMinusCos = sin2 / (1 + std::sqrt(1 - sin2));
+    if (!(oneMinusCos >= 1e-6)) return 0;
+    if (cosMax) *cosMax = float(1 - oneMinusCos);
     return 1 / (2 * double(Pi) * oneMinusCos);
 }
 
@@ -294,8 +300,8 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
     SphereConnection roots[MaxSphereConnections];
     for (const GlassSphere& s : scene.glassSpheres) {
         if (s.outside != region) continue;
-        const double pc = ballConePdf(s, v.p);
-        if (!(pc > 0)) continue;
+        float cosMax = 1;
+        const double pc = ballConePdf(s, v.p, &cosMax);
         // What reaches x from y through the ball along the connection cn:
         // transmittance x -> p1, nothing inside the ball, p2 -> y.
         auto throughBall = [&](const SphereConnection& cn, const Vec3& y) {
@@ -337,9 +343,9 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             // 2. A direction uniform in the ball's cone, traced through it:
             // where the lens focuses the light (G near 0), the light fills
             // much of the ball and this finds it where connections cannot.
+            if (!(pc > 0)) continue;
             SphereConnection cn;
             const Vec3 axis = normalize(s.center - v.p);
-            const float cosMax = float(1 - 1 / (2 * double(Pi) * pc));
             const Vec3 w = sampleUniformCone(axis, cosMax, rng.uniform(), rng.uniform());
             if (!traceThroughSphere(s, v.p, w, cn)) continue;
             const Vec3 oc = cn.p2 - lc;
