@@ -144,7 +144,7 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
     const D3 yPerp = cy - e1 * dot(cy, e1);
     const double yh = length(yPerp);
     if (!(yh > 1e-9 * (R + length(cy)))) return 0;  // y on the axis: a ring of paths, measure zero
-    const D3 e2 = yPerp * (1 / yh), e3 = cross(e1, e2);
+    const D3 e2 = yPerp * (1 / yh);
     // Directions to the outline point at angle a from e1; the visible arc is
     // |a| < acos(R / dx).
     const double aMax = std::acos(R / dx);
