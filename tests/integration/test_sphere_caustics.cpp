@@ -26,6 +26,10 @@ Image renderWith(const std::string& sample, std::vector<std::string> overrides, 
 const std::vector<std::string> CausticScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
                                                "render.max_depth=4", "render.spp=768"};
 
+// A sphere light over the ball that paths through it find often.
+const char* const LargeLight =
+    R"(lights=[{"type": "sphere", "position": [0, 2.2, 0], "radius": 0.5, "power": [300, 290, 270]}])";
+
 TEST(SphereCausticRenders, FogAndFloorUnderAGlassBallAgreeWithPathsAlone) {
     const Image on = renderWith("scenes/fig4_caustic_sphere.json", CausticScene, true);
     const Image off = renderWith("scenes/fig4_caustic_sphere.json", CausticScene, false);
@@ -36,7 +40,7 @@ TEST(SphereCausticRenders, ALargeLightThatPathsFindOftenAgreesWithPathsAlone) {
     // A light the paths find often through the ball: every technique's
     // share counts (connections, directions towards the ball, the paths).
     std::vector<std::string> o = CausticScene;
-    o.push_back(R"(lights=[{"type": "sphere", "position": [0, 2.2, 0], "radius": 0.5, "power": [300, 290, 270]}])");
+    o.push_back(LargeLight);
     const Image on = renderWith("scenes/fig4_caustic_sphere.json", o, true);
     const Image off = renderWith("scenes/fig4_caustic_sphere.json", o, false);
     expectPairedAgreement(off, on, "a large light over the ball");
@@ -45,9 +49,11 @@ TEST(SphereCausticRenders, ALargeLightThatPathsFindOftenAgreesWithPathsAlone) {
 TEST(SphereCausticRenders, GuidedMarcherAgreesWithItsPathsAlone) {
     // The marcher's L_i samples connect too (li = "path"), and its
     // continuation paths weigh their hits against that.
+    // The large light: paths find it often, so the comparison is sharp.
     std::vector<std::string> o = CausticScene;
-    o.back() = "render.spp=256";
+    o.back() = "render.spp=128";
     o[1] = "render.method=\"guided\"";
+    o.push_back(LargeLight);
     const Image on = renderWith("scenes/fig4_caustic_sphere.json", o, true);
     const Image off = renderWith("scenes/fig4_caustic_sphere.json", o, false);
     expectPairedAgreement(off, on, "guided on fig4_caustic_sphere");
