@@ -97,11 +97,6 @@ double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y, co
     return length(cross(q[0] - q0, q[1] - q0)) / (eps * eps);
 }
 
-double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y) {
-    Traced base;
-    return trace(s, x, w, base) ? spreading(s, x, w, y, base) : 0;
-}
-
 SphereConnection toConnection(const D3& w, const Traced& tr, double G) {
     SphereConnection c;
     c.wi = w.f();
@@ -126,10 +121,6 @@ bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, Sphe
     if (!trace(s, D3(x), wd, tr)) return false;
     out = toConnection(wd, tr, 0);
     return true;
-}
-
-double sphereRaySpreading(const GlassSphere& s, const Vec3& x, const Vec3& w, const Vec3& y) {
-    return spreading(s, D3(x), normalize(D3(w)), D3(y));
 }
 
 int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, SphereConnection out[MaxSphereConnections]) {

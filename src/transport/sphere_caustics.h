@@ -59,10 +59,6 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, Sph
 // ray misses the sphere.
 bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out);
 
-// G for the path leaving x along w through s, measured at the plane through
-// y perpendicular to the exit direction.
-double sphereRaySpreading(const GlassSphere& s, const Vec3& x, const Vec3& w, const Vec3& y);
-
 // The caustic light at vertex v (in `region`) from every sphere light
 // through every glass sphere: the connections to one light point and one
 // direction in the ball's cone, each weighed against the other and the
