@@ -44,11 +44,6 @@ bool mayBeInside(const Scene& scene, const Vec3& p, const std::vector<int>& arou
     return false;
 }
 
-// Scene::shadowRaysCanReach. A region is sealed when every surface that
-// names it is closed, blocks shadow rays and has it as its interior (so the
-// region lies inside those surfaces, bounded); a light is then out of reach
-// when it lies outside all of them: any straight ray from the region to it
-// crosses one.
 // The spheres of refracting glass, uniformly scaled and empty inside, that
 // next-event estimation sees light through (transport/sphere_caustics.h).
 void findGlassSpheres(Scene& scene) {
@@ -82,6 +77,11 @@ void findGlassSpheres(Scene& scene) {
     }
 }
 
+// Scene::shadowRaysCanReach. A region is sealed when every surface that
+// names it is closed, blocks shadow rays and has it as its interior (so the
+// region lies inside those surfaces, bounded); a light is then out of reach
+// when it lies outside all of them: any straight ray from the region to it
+// crosses one.
 void computeShadowReach(Scene& scene) {
     const size_t nLights = scene.lights.size(), nRegions = scene.regions.size();
     scene.shadowReach.assign(nRegions * (nLights + 1), 1);

@@ -11,8 +11,7 @@ Color ScatterVertex::f(const Vec3& wi) const {
     // cos between the light's travel direction (-wi) and the scattered
     // direction (-d).
     if (phase) return phase->eval(dot(wi, d));
-    const Vec3 nf = dot(n, d) < 0 ? n : -n;
-    const float c = dot(wi, nf);
+    const float c = dot(wi, arrivalNormal());
     return c > 0 ? albedo * (c * InvPi) : Color(0);
 }
 
@@ -23,8 +22,12 @@ float ScatterVertex::pdf(const Vec3& wi) const {
 
 float ScatterVertex::fPdf(const Vec3& wi) const {
     if (phase) return phase->pdf(dot(wi, d));
-    const Vec3 nf = dot(n, d) < 0 ? n : -n;
-    return std::max(0.f, dot(wi, nf)) * InvPi;
+    return std::max(0.f, dot(wi, arrivalNormal())) * InvPi;
+}
+
+Vec3 ScatterVertex::shadowOrigin(const Scene& scene) const {
+    if (phase) return p;
+    return p + arrivalNormal() * (1e-5f * std::max(scene.sceneScale, maxComponent(max(p, -p))));
 }
 
 namespace {
@@ -53,11 +56,7 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
     const Scene& scene = ctx.scene;
     const float rouletteLevel = phaseRouletteLevel(scene, region, v, o);
     Color L(0);
-    Vec3 origin = v.p, nf;
-    if (!v.phase) {  // leave the surface on the side the path arrived from
-        nf = dot(v.n, v.d) < 0 ? v.n : -v.n;
-        origin = v.p + nf * (1e-5f * std::max(scene.sceneScale, maxComponent(max(v.p, -v.p))));
-    }
+    const Vec3 origin = v.shadowOrigin(scene);
     for (size_t i = 0; i < scene.lights.size(); ++i) {
         const Light& light = scene.lights[i];
         if (o.onlyLight >= 0 && int(i) != o.onlyLight) continue;
@@ -111,7 +110,7 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
             if (!(pdf > 0)) return L;
         } else {
             const float cosTheta = std::sqrt(1 - u1);
-            wi = directionAround(nf, cosTheta, u2);
+            wi = directionAround(v.arrivalNormal(), cosTheta, u2);
             weight = v.albedo;
             pdf = cosTheta * InvPi;
         }

@@ -31,6 +31,12 @@ struct ScatterVertex {
         return {p, d, nullptr, n, albedo};
     }
 
+    // Surface only: the normal on the side the path arrived from.
+    Vec3 arrivalNormal() const { return dot(n, d) < 0 ? n : -n; }
+    // Where shadow rays from here start: p, or off a surface on the
+    // arrival side.
+    Vec3 shadowOrigin(const Scene& scene) const;
+
     // f (phase, or albedo cos / pi) for light arriving from direction wi; 0
     // below a surface.
     Color f(const Vec3& wi) const;

@@ -101,6 +101,15 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         float pdf = 0;
     };
     std::array<SplitCopy, MaxSplitPaths - 1> copies;
+    // Next-event estimation at a vertex of the path, and the connections to
+    // sphere lights through glass spheres (sphere_caustics.h); true when
+    // those were made (the path's own hits through a ball weigh against them).
+    auto nextEvent = [&](const ScatterVertex& vertex, const float* lightWeights) {
+        add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, lightWeights)), st.depth);
+        if (!regionHasSphereCaustics(scene, region)) return false;
+        add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching), st.depth);
+        return true;
+    };
     while (true) {
         // A guide may take this segment's free flight (path_guide.h); at
         // max_depth a collision could only end the path, so it is tracked.
@@ -150,11 +159,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
             const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
-            add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, weights)), st.depth);
-            const bool caustics = regionHasSphereCaustics(scene, region);
-            if (caustics)
-                add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching),
-                    st.depth);
+            const bool caustics = nextEvent(vertex, weights);
             // Guided roulette and splitting of what follows the vertex.
             int paths = 1;
             if (st.windowReference > 0) {
@@ -275,12 +280,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             if (++st.depth > maxDepth) return result(0.f);
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            const ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
-            add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st)), st.depth);
-            const bool caustics = regionHasSphereCaustics(scene, region);
-            if (caustics)
-                add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching),
-                    st.depth);
+            const bool caustics = nextEvent(ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), nullptr);
             startVertex(st, h.p, e.ray.d, e.pdf, caustics);
         } else if (!e.straight) {
             st.specular = true;  // next-event estimation cannot see through this

@@ -283,11 +283,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                          TransmittanceEstimator estimator) {
     const Scene& scene = ctx.scene;
     Color L(0);
-    Vec3 origin = v.p;
-    if (!v.phase) {  // leave the surface on the side the path arrived from
-        const Vec3 nf = dot(v.n, v.d) < 0 ? v.n : -v.n;
-        origin = v.p + nf * (1e-5f * std::max(scene.sceneScale, maxComponent(max(v.p, -v.p))));
-    }
+    const Vec3 origin = v.shadowOrigin(scene);
     SphereConnection roots[MaxSphereConnections];
     for (const GlassSphere& s : scene.glassSpheres) {
         if (s.outside != region) continue;
@@ -339,12 +335,12 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             const Vec3 axis = normalize(s.center - v.p);
             const Vec3 w = sampleUniformCone(axis, cosMax, rng.uniform(), rng.uniform());
             if (!traceThroughSphere(s, v.p, w, cn)) continue;
-            const Vec3 oc = cn.p2 - lc;
-            const float b = dot(cn.wo, oc), c = dot(oc, oc) - rl * rl, disc = b * b - c;
-            if (!(c > 0) || !(b < 0) || !(disc > 0)) continue;  // misses the light
+            // p2 lies outside the light (lightOutside): its first hit faces the ball.
+            float tLight;
+            if (!light.intersect(Ray{cn.p2, cn.wo}, 0.f, Infinity, tLight)) continue;
             const Color f = v.f(cn.wi);
             if (isBlack(f)) continue;
-            const Vec3 yHit = cn.p2 + cn.wo * (-b - std::sqrt(disc));
+            const Vec3 yHit = cn.p2 + cn.wo * tLight;
             const Color T = throughBall(cn, yHit);
             if (isBlack(T)) continue;
             const double pm = connectionPdf(s, light, v.p, cn.wi, yHit);
