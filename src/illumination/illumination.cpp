@@ -72,9 +72,9 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
     if (needCache && !rq.cacheFile.empty()) {
         RadianceCache c = RadianceCache::load(rq.cacheFile);
         checkCacheMatchesScene(c, scene, rq.cacheFile, rq.force);
-        if (rq.cacheSettings.directionLobes)
-            warn(str(rq.cacheFile, ": a cache file holds no direction lobes (render.product_sampling); "
-                                   "continuation directions follow the phase function"));
+        if (rq.cacheSettings.directionLobes && !c.directionLobes)
+            warn(str(rq.cacheFile, ": the cache holds no direction lobes (bake it with render.product_sampling "
+                                   "= true); continuation directions follow the phase function"));
         il.cache = std::make_unique<RadianceCache>(std::move(c));
         il.cacheLoaded = true;
         needCache = false;
