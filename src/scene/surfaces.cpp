@@ -116,6 +116,15 @@ void SurfaceSet::addSphere(const Transform& toWorld, int surfaceIndex) {
 void SurfaceSet::commit() {
     rtcCommitScene(mEmbree->scene);
     mEmbree->check("building the surface BVH");
+    // Padded by far more than the slab test's rounding, so that no hit
+    // Embree would find is culled (pixels stay bit-identical).
+    mCullBounds = bounds();
+    if (!mCullBounds.empty()) {
+        const Vec3 pad = (mCullBounds.hi - mCullBounds.lo) * 1e-3f + max(mCullBounds.hi, -mCullBounds.lo) * 1e-5f +
+                         Vec3(1e-6f);
+        mCullBounds.lo -= pad;
+        mCullBounds.hi += pad;
+    }
 }
 
 size_t SurfaceSet::primitiveCount() const {
@@ -126,6 +135,10 @@ size_t SurfaceSet::primitiveCount() const {
 
 bool SurfaceSet::intersect(const Ray& r, float tMin, float tMax, SurfaceHit& hit) const {
     if (mGeometries.empty()) return false;
+    // Most rays of a scene with a few surfaces (a floor, a glass ball) miss
+    // them all: a slab test costs a fraction of Embree's call.
+    float t0 = tMin, t1 = tMax;
+    if (!mCullBounds.intersect(r, t0, t1)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;

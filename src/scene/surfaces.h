@@ -59,6 +59,8 @@ private:
     void attach(::RTCGeometryTy* geometry, const char* what);
     std::unique_ptr<Embree> mEmbree;
     std::vector<Geometry> mGeometries;
+    // bounds(), padded (commit()): a ray that misses it skips Embree.
+    BBox mCullBounds;
 };
 
 }  // namespace vdbmarch
