@@ -17,10 +17,20 @@
 namespace vdbmarch {
 namespace {
 
-// Two tiny spheres far out, so that `set`'s bounds hold every ray below.
-void addFarSpecks(SurfaceSet& set) {
-    for (float s : {-100.f, 100.f}) set.addSphere(Transform(Mat4::translate(Vec3(s)) * Mat4::scale(Vec3(0.01f))), 1);
-}
+// The surface alone (`culled`), and with two tiny spheres far out (`whole`,
+// whose bounds hold every ray of the tests: nothing near it is culled).
+struct CulledAndWhole {
+    SurfaceSet culled, whole;
+    template <typename Add>
+    explicit CulledAndWhole(Add add) {
+        add(culled);
+        add(whole);
+        for (float s : {-100.f, 100.f})
+            whole.addSphere(Transform(Mat4::translate(Vec3(s)) * Mat4::scale(Vec3(0.01f))), 1);
+        culled.commit();
+        whole.commit();
+    }
+};
 
 // The same hit or miss from both sets; hits beyond `far` (a speck) count as misses.
 void expectSameAnswer(const SurfaceSet& culled, const SurfaceSet& whole, const Ray& r, int i, int& hits) {
@@ -41,12 +51,7 @@ TEST(SurfaceSet, BoundsCullingKeepsEveryHitOfABox) {
     const Vec3 lo(-3, -0.9f, -4), hi(3, -0.8f, 3);
     TriangleMesh box = makeUnitBox();
     transformMesh(box, [&](const Vec3& p) { return lo + (hi - lo) * (p + Vec3(0.5f)); });
-    SurfaceSet culled, whole;
-    culled.addMesh(box, 0);
-    whole.addMesh(box, 0);
-    addFarSpecks(whole);
-    culled.commit();
-    whole.commit();
+    const CulledAndWhole sets([&](SurfaceSet& set) { set.addMesh(box, 0); });
     Rng rng(5);
     int hits = 0;
     for (int i = 0; i < 40000; ++i) {
@@ -63,7 +68,7 @@ TEST(SurfaceSet, BoundsCullingKeepsEveryHitOfABox) {
         if (i % 3 == 0) dir[int(rng.uniform() * 3)] *= 1e-4f;
         dir = normalize(dir);
         const Vec3 o = target - dir * (i % 5 == 0 ? 0.f : 2 + 10 * rng.uniform());
-        expectSameAnswer(culled, whole, Ray{o, dir}, i, hits);
+        expectSameAnswer(sets.culled, sets.whole, Ray{o, dir}, i, hits);
         if (::testing::Test::HasFatalFailure()) return;
     }
     EXPECT_GT(hits, 10000);
@@ -71,12 +76,7 @@ TEST(SurfaceSet, BoundsCullingKeepsEveryHitOfABox) {
 
 TEST(SurfaceSet, BoundsCullingKeepsEveryHitOfAnEllipsoid) {
     const Transform xf(Mat4::translate(Vec3(4, -1, 2)) * Mat4::scale(Vec3(0.5f, 2, 1)));
-    SurfaceSet culled, whole;
-    culled.addSphere(xf, 0);
-    whole.addSphere(xf, 0);
-    addFarSpecks(whole);
-    culled.commit();
-    whole.commit();
+    const CulledAndWhole sets([&](SurfaceSet& set) { set.addSphere(xf, 0); });
     Rng rng(7);
     int hits = 0;
     for (int i = 0; i < 40000; ++i) {
@@ -91,7 +91,7 @@ TEST(SurfaceSet, BoundsCullingKeepsEveryHitOfAnEllipsoid) {
         if (dot(dir, n) > 0) dir = -dir;
         if (i % 3 == 0) dir = normalize(dir - n * (dot(dir, n) * 0.999f));
         const Vec3 o = target - dir * (2 + 10 * rng.uniform());
-        expectSameAnswer(culled, whole, Ray{o, dir}, i, hits);
+        expectSameAnswer(sets.culled, sets.whole, Ray{o, dir}, i, hits);
         if (::testing::Test::HasFatalFailure()) return;
     }
     EXPECT_GT(hits, 10000);
