@@ -116,6 +116,9 @@ struct RenderSettings {
     // Path vertices connect to sphere lights through glass spheres
     // (transport/sphere_caustics.h), weighed by MIS against the path's hits.
     bool sphereCaustics = true;
+    // Medium vertices of the path tracer draw a share of their directions
+    // towards spot lights' beams (transport/beam_directions.h).
+    bool beamDirections = true;
     // Noise target (render --noise): > 0 stops the render once the
     // estimated RMSE over the image's mean is below it, sampling only the
     // blocks of pixels still above it (adaptive sampling, docs/noise.md).

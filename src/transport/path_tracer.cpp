@@ -4,6 +4,7 @@
 #include <array>
 
 #include "core/sampling.h"
+#include "transport/beam_directions.h"
 #include "transport/direct_light.h"
 #include "transport/light_distance.h"
 #include "transport/media_point.h"
@@ -158,6 +159,13 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             }
             ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
             const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
+            // Or a share of the directions towards spot beams (beam_directions.h).
+            const BeamMixture beams{&ctx, region, &vertex};
+            const bool beamDirections = !guidedDirection && regionHasBeamDirections(ctx, region, st.pointLightsByPhotons);
+            if (beamDirections) {
+                vertex.pathPdf = &BeamMixture::pdfOf;
+                vertex.pathSampler = &beams;
+            }
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
             const bool caustics = nextEvent(vertex, weights);
             // Guided roulette and splitting of what follows the vertex.
@@ -177,6 +185,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             // The next direction (the guide's or the phase's), for the path
             // and for each copy split from it.
             auto sampleDirection = [&](Color& b, float& pdf) {
+                if (beamDirections) return beams.sample(rng, b, pdf);
                 const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
                 if (!guidedDirection) return mp.phase.sample(ray.d, u0, u1, u2, b, pdf);
                 Color w(0);
@@ -277,11 +286,27 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return result(0.f);
         const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
         const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
+        Color weight = e.weight;
+        Ray next = e.ray;
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             if (++st.depth > maxDepth) return result(0.f);
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            const bool caustics = nextEvent(ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), nullptr);
-            startVertex(st, h.p, e.ray.d, e.pdf, caustics);
+            ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
+            // A share of the directions towards spot beams (beam_directions.h).
+            const BeamMixture beams{&ctx, region, &vertex};
+            const bool beamDirections = regionHasBeamDirections(ctx, region, st.pointLightsByPhotons);
+            if (beamDirections) {
+                vertex.pathPdf = &BeamMixture::pdfOf;
+                vertex.pathSampler = &beams;
+            }
+            const bool caustics = nextEvent(vertex, nullptr);
+            float pdf = e.pdf;
+            if (beamDirections) {
+                weight = Color(1);
+                next.d = beams.sample(rng, weight, pdf);
+                next.o = offsetRayOrigin(scene, h.p, vertex.arrivalNormal(), next.d);
+            }
+            startVertex(st, h.p, next.d, pdf, caustics);
         } else if (!e.straight) {
             st.specular = true;  // next-event estimation cannot see through this
             // Two refractions through one glass sphere keep the pattern of
@@ -293,8 +318,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 ++st.lensRefractions;
             }
         }
-        beta *= e.weight;
-        ray = e.ray;
+        beta *= weight;
+        ray = next;
         region = e.region;
         if (e.kind == SurfaceEvent::Kind::Diffuse && !roulette(beta, st.depth, rng)) return result(0.f);
     }

@@ -43,6 +43,19 @@ struct ThreadContext {
     // ever get distance samples there.
     std::vector<BBox> scatterBounds;
     std::vector<char> lightDistanceCandidate;
+    // Made on first use by beam_directions.cpp: per region, the spot beams
+    // its medium vertices draw directions towards.
+    struct Beam {
+        int light;
+        Vec3 apex, axis, e1, e2;
+        float tanCone, cosCone;
+        float s0, s1;      // the axial range sampled (the region's media)
+        float choice = 1;  // probability of this beam
+    };
+    struct BeamRegion {
+        std::vector<Beam> beams;
+    };
+    std::vector<BeamRegion> beamRegions;
     RenderCounters counters;
     std::unique_ptr<ThreadContextExtension> extension;
 

@@ -17,10 +17,8 @@ namespace {
 
 using namespace test;
 
-Image renderWith(const std::string& sample, std::vector<std::string> overrides, bool caustics, int seed = 3) {
-    overrides.push_back(std::string("render.sphere_caustics=") + (caustics ? "true" : "false"));
-    overrides.push_back("render.seed=" + std::to_string(seed));
-    return renderImage(*buildScene(loadSceneFile(samplePath(sample), overrides))).image;
+Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool caustics, int seed = 3) {
+    return renderSampleToggled(sample, overrides, "render.sphere_caustics", caustics, seed);
 }
 
 const std::vector<std::string> CausticScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
@@ -63,19 +61,11 @@ TEST(SphereCausticRenders, ConnectionsQuietTheCaustic) {
     // Pair RMSE of two seeds, with and without: the connections must take
     // the noise per sample well below the paths' (measured 0.13x the MSE at
     // 160x120; here at least 2x less).
-    auto pairMse = [](bool caustics) {
-        const Image a = renderWith("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 11);
-        const Image b = renderWith("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 23);
-        double sum = 0;
-        for (int y = 0; y < a.height; ++y)
-            for (int x = 0; x < a.width; ++x)
-                for (int c = 0; c < 3; ++c) {
-                    const double d = double(a.rgb(x, y)[c]) - double(b.rgb(x, y)[c]);
-                    sum += d * d;
-                }
-        return sum / (3.0 * a.width * a.height);
+    auto noise = [](bool caustics) {
+        return test::pairMse(renderWith("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 11),
+                             renderWith("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 23));
     };
-    EXPECT_LT(pairMse(true), 0.5 * pairMse(false));
+    EXPECT_LT(noise(true), 0.5 * noise(false));
 }
 
 TEST(SphereCausticRenders, CloudWithGlassLightsAndSkyAgreesWithPathsAlone) {

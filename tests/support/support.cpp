@@ -191,6 +191,26 @@ ChannelStats pixelStats(const Image& img, int channel) {
     return {s.mean(), s.stdError()};
 }
 
+double pairMse(const Image& a, const Image& b) {
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    double sum = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double d = double(a.rgb(x, y)[c]) - double(b.rgb(x, y)[c]);
+                sum += d * d;
+            }
+    return sum / (3.0 * a.width * a.height);
+}
+
+Image renderSampleToggled(const std::string& sample, std::vector<std::string> overrides, const std::string& toggle,
+                          bool on, int seed) {
+    overrides.push_back(toggle + (on ? "=true" : "=false"));
+    overrides.push_back("render.seed=" + std::to_string(seed));
+    return renderImage(*buildScene(loadSceneFile(samplePath(sample), overrides))).image;
+}
+
 void expectPairedAgreement(const Image& a, const Image& b, const std::string& what) {
     ASSERT_EQ(a.width, b.width);
     ASSERT_EQ(a.height, b.height);

@@ -206,6 +206,15 @@ ChannelStats pixelStats(const Image& img, int channel);
 // colour channel, within 4 standard errors. `what` names the case.
 void expectPairedAgreement(const Image& a, const Image& b, const std::string& what);
 
+// The mean over pixels and colour channels of the squared difference of two
+// renders (of two seeds: twice each one's variance).
+double pairMse(const Image& a, const Image& b);
+
+// A sample scene rendered with `overrides`, the boolean render setting
+// `toggle` (e.g. "render.sphere_caustics") set to `on`, and render.seed.
+Image renderSampleToggled(const std::string& sample, std::vector<std::string> overrides, const std::string& toggle,
+                          bool on, int seed);
+
 // Overrides of vdb_samples/cloud_sky.json for the unbiasedness checks of the
 // path tracer's samplers: a 32x24 view, max_depth 6, the sky at 0.3, a point
 // light inside the cloud, a spot and a sphere light, and a glass ball in

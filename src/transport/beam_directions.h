@@ -1,0 +1,55 @@
+// Directions towards the beams of spot lights, mixed with f's own sampling
+// at the path tracer's medium and diffuse vertices (render.beam_directions).
+//
+// In a thin haze lit by spots, most of the light a path can still find is
+// in the beams (and on the floor patches they light); a phase- or
+// cosine-sampled direction crosses one rarely, and the
+// distance samples towards the light (light_distance.h) only pay on the
+// segments that do. So with probability BeamShare a vertex draws a point
+// in a beam instead, uniform along the spot's axis over the axial range of
+// the region's scattering media and uniform over the cone's disc there
+// (the scattered power per unit length of a beam is about constant: the
+// falloff 1/s^2 and the disc's area s^2 cancel), and goes towards it. The
+// density of that direction is the volume density integrated along the ray
+// (times t^2), in closed form (beamDirectionPdf). The vertex weighs by the
+// one-sample mixture, f / ((1 - p) p_phase + p p_beams), so the estimate
+// is unbiased for any beams and lights, and next-event estimation meets the
+// same density by MIS (ScatterVertex::pathPdf).
+#pragma once
+
+#include "core/math.h"
+#include "core/rng.h"
+#include "transport/direct_light.h"
+#include "transport/thread_context.h"
+
+namespace vdbmarch {
+
+// The share of the beams in the mixture.
+constexpr float BeamShare = 0.5f;
+
+// True when the beams of region `region` are sampled at its vertices:
+// render.beam_directions, a spot light whose distance sampling may pay
+// there (light_distance.h), and bounded, thin scattering media (an optical
+// depth of at most 4 across their bounds at the densest extinction).
+bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLights);
+
+// The density (solid angle) of a direction drawn towards the region's
+// beams from x (no phase share).
+float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi);
+
+// A vertex's direction sampler: f's own sampling (the phase function, or
+// the cosine on a diffuse surface) mixed with the beams.
+struct BeamMixture {
+    ThreadContext* ctx;
+    int region;
+    const ScatterVertex* vertex;
+
+    // wi, f / pdf per channel (f cos on a surface) and the mixture's pdf;
+    // pdf 0 (weight 0): no direction.
+    Vec3 sample(Rng& rng, Color& weight, float& pdf) const;
+    float pdf(const Vec3& wi) const;
+    // For ScatterVertex::pathPdf.
+    static float pdfOf(const void* self, const Vec3& wi) { return static_cast<const BeamMixture*>(self)->pdf(wi); }
+};
+
+}  // namespace vdbmarch
