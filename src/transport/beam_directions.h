@@ -25,7 +25,7 @@
 namespace vdbmarch {
 
 // The share of the beams in the mixture.
-constexpr float BeamShare = 0.5f;
+constexpr float BeamShare = 0.3f;
 
 // True when the beams of region `region` are sampled at its vertices:
 // render.beam_directions, a spot light whose distance sampling may pay
