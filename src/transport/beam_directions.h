@@ -50,6 +50,16 @@ struct BeamMixture {
     float pdf(const Vec3& wi) const;
     // For ScatterVertex::pathPdf.
     static float pdfOf(const void* self, const Vec3& wi) { return static_cast<const BeamMixture*>(self)->pdf(wi); }
+
+    // True when `region` samples beams (regionHasBeamDirections); then the
+    // vertex's path density is this mixture's (next-event MIS meets it).
+    bool attach(ScatterVertex& v, bool skipPointLights) {
+        if (!regionHasBeamDirections(*ctx, region, skipPointLights)) return false;
+        vertex = &v;
+        v.pathPdf = &BeamMixture::pdfOf;
+        v.pathSampler = this;
+        return true;
+    }
 };
 
 }  // namespace vdbmarch

@@ -160,12 +160,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
             const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
             // Or a share of the directions towards spot beams (beam_directions.h).
-            const BeamMixture beams{&ctx, region, &vertex};
-            const bool beamDirections = !guidedDirection && regionHasBeamDirections(ctx, region, st.pointLightsByPhotons);
-            if (beamDirections) {
-                vertex.pathPdf = &BeamMixture::pdfOf;
-                vertex.pathSampler = &beams;
-            }
+            BeamMixture beams{&ctx, region, &vertex};
+            const bool beamDirections = !guidedDirection && beams.attach(vertex, st.pointLightsByPhotons);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
             const bool caustics = nextEvent(vertex, weights);
             // Guided roulette and splitting of what follows the vertex.
@@ -293,17 +289,14 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
             ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
             // A share of the directions towards spot beams (beam_directions.h).
-            const BeamMixture beams{&ctx, region, &vertex};
-            const bool beamDirections = regionHasBeamDirections(ctx, region, st.pointLightsByPhotons);
-            if (beamDirections) {
-                vertex.pathPdf = &BeamMixture::pdfOf;
-                vertex.pathSampler = &beams;
-            }
+            BeamMixture beams{&ctx, region, &vertex};
+            const bool beamDirections = beams.attach(vertex, st.pointLightsByPhotons);
             const bool caustics = nextEvent(vertex, nullptr);
             float pdf = e.pdf;
             if (beamDirections) {
                 weight = Color(1);
                 next.d = beams.sample(rng, weight, pdf);
+                if (isBlack(weight)) return result(0.f);  // a beam below the surface
                 next.o = offsetRayOrigin(scene, h.p, vertex.arrivalNormal(), next.d);
             }
             startVertex(st, h.p, next.d, pdf, caustics);
