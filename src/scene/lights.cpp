@@ -111,10 +111,40 @@ bool Light::reachInterval(const Ray& r, float& t0, float& t1) const {
     const double c = mCosCone, c2 = c * c;
     const double av = dot(a, v), ad = dot(a, r.d), vd = dot(v, r.d), vv = lengthSquared(v), dd = lengthSquared(r.d);
     const double A = ad * ad - c2 * dd, B = 2 * (av * ad - c2 * vd), C = av * av - c2 * vv;
+    const bool quadratic = std::fabs(A) > 1e-12 * (std::fabs(B) + std::fabs(C) + 1e-30);
+    // A cone narrower than a hemisphere is convex: the ray meets it in one
+    // interval, which the roots and the signs of A and a.d give without
+    // probing the pieces (the same set as the general walk below).
+    if (c > 0.01 && quadratic) {
+        const double disc = B * B - 4 * A * C;
+        if (disc >= 0) {
+            const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+            double r0 = q / A, r1 = q != 0 ? C / q : r0;
+            if (r0 > r1) std::swap(r0, r1);
+            double lo, hi;
+            if (A < 0) {  // f > 0 between the roots, in one nappe: the lit one?
+                if (!(av + 0.5 * (r0 + r1) * ad > 0)) return false;
+                lo = r0;
+                hi = r1;
+            } else if (ad > 0) {  // f > 0 outside the roots; the lit nappe ahead
+                lo = r1;
+                hi = Infinity;
+            } else {  // the lit nappe behind
+                lo = -Infinity;
+                hi = r0;
+            }
+            lo = std::max(lo, 0.0);
+            if (!(hi > lo)) return false;
+            t0 = float(lo);
+            t1 = std::isinf(hi) ? Infinity : float(hi);
+            return true;
+        }
+        if (A < 0) return false;  // f < 0 everywhere: outside both nappes
+    }
     double cuts[4];
     int n = 0;
     cuts[n++] = 0;
-    if (std::fabs(A) > 1e-12 * (std::fabs(B) + std::fabs(C) + 1e-30)) {
+    if (quadratic) {
         const double disc = B * B - 4 * A * C;
         if (disc >= 0) {
             const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));

@@ -97,9 +97,9 @@ double inverseSquareMoment(double sx, double c, double ta, double tb) {
 // The density of directions towards beam b from x (solid angle): the
 // volume density 1 / ((s1 - s0) pi tan^2 s^2) integrated along the ray over
 // the cone's part in [s0, s1], with the Jacobian t^2.
-double beamPdf(const ThreadContext::Beam& b, const Light& light, const Vec3& x, const Vec3& wi) {
+double beamPdf(ThreadContext& ctx, const ThreadContext::Beam& b, const Vec3& x, const Vec3& wi) {
     float t0, t1;
-    if (!light.reachInterval(Ray{x, wi}, t0, t1)) return 0;
+    if (!lightReach(ctx, b.light, Ray{x, wi}, t0, t1)) return 0;
     const double sx = double(dot(x - b.apex, b.axis)), c = double(dot(wi, b.axis));
     double ta = t0, tb = t1;
     if (std::fabs(c) < 1e-12) {
@@ -127,7 +127,7 @@ bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLight
 float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi) {
     double pdf = 0;
     for (const ThreadContext::Beam& b : ctx.beamRegions[size_t(region)].beams)
-        pdf += double(b.choice) * beamPdf(b, ctx.scene.lights[size_t(b.light)], x, wi);
+        pdf += double(b.choice) * beamPdf(ctx, b, x, wi);
     return float(pdf);
 }
 

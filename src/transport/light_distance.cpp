@@ -100,6 +100,21 @@ bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLight
     return false;
 }
 
+bool lightReach(ThreadContext& ctx, int light, const Ray& ray, float& t0, float& t1) {
+    if (light >= ThreadContext::ReachMemoLights) return ctx.scene.lights[size_t(light)].reachInterval(ray, t0, t1);
+    ThreadContext::ReachMemo& m = ctx.reachMemo[light];
+    if (!(m.valid && m.o.x == ray.o.x && m.o.y == ray.o.y && m.o.z == ray.o.z && m.d.x == ray.d.x &&
+          m.d.y == ray.d.y && m.d.z == ray.d.z)) {
+        m.reaches = ctx.scene.lights[size_t(light)].reachInterval(ray, m.t0, m.t1);
+        m.o = ray.o;
+        m.d = ray.d;
+        m.valid = true;
+    }
+    t0 = m.t0;
+    t1 = m.t1;
+    return m.reaches;
+}
+
 LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
                                            bool skipPointLights) {
     ctx.lightDistances.clear();
@@ -117,7 +132,7 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
         if (!eligible(i)) continue;
         const Light& light = scene.lights[i];
         float t0, t1;
-        if (!light.reachInterval(ray, t0, t1)) continue;
+        if (!lightReach(ctx, int(i), ray, t0, t1)) continue;
         t0 = std::max(t0, a);
         t1 = std::min(t1, b);
         if (!(t1 > t0)) continue;

@@ -53,6 +53,10 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
 // (prepareLightDistances then needs the segment's true end).
 bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights);
 
+// Light::reachInterval of scene light `light` for `ray`, remembered per
+// thread for the last ray asked (bit-identical rays only).
+bool lightReach(ThreadContext& ctx, int light, const Ray& ray, float& t0, float& t1);
+
 // One distance sample, for one prepared light (chosen by its odds):
 // T(t) sigma_s(t) f L T_shadow w / pdf(t), the light's single scattering
 // along the segment weighted for MIS.
