@@ -1,6 +1,9 @@
 #include "transport/beam_directions.h"
 
 #include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
 
 #include "core/sampling.h"
 #include "transport/light_distance.h"
@@ -13,6 +16,50 @@ namespace {
 // The largest optical depth across a region's bounds (its densest
 // extinction times the diagonal) where beams are sampled.
 constexpr double MaxBeamRegionDepth = 4;
+
+// The beams' axial density (BeamView): bins along the axis, and the angle
+// table's resolution.
+constexpr int BeamBins = 16;
+constexpr int BeamAngleSteps = 256;
+
+// The asymmetry of a region's scattering media, weighted by their densest
+// scattering: the phase the axial density assumes (a proposal only).
+float regionPhaseG(const Scene& scene, int region) {
+    double sum = 0, weight = 0;
+    for (int mi : scene.regions[size_t(region)].media) {
+        const Medium& m = *scene.media[size_t(mi)];
+        const double w = double(average(m.sigma_s)) * double(m.maxDensity());
+        sum += w * double(m.g);
+        weight += w;
+    }
+    return weight > 0 ? float(sum / weight) : 0.f;
+}
+
+// G(theta) = int_0^theta p_HG(cos a, g) da at BeamAngleSteps + 1 angles,
+// by Simpson's rule on 8 sub-steps per step. Made once per g in the process
+// (thread contexts are made per block of pixels and sweep; the table took
+// a tenth of a timed render's time when each made its own).
+const std::vector<float>* phaseAngleIntegral(float g) {
+    static std::mutex mutex;
+    static std::map<float, std::unique_ptr<const std::vector<float>>> tables;
+    const std::lock_guard<std::mutex> lock(mutex);
+    std::unique_ptr<const std::vector<float>>& table = tables[g];
+    if (!table) {
+        std::vector<float> G(BeamAngleSteps + 1, 0.f);
+        const double step = PiD / BeamAngleSteps, h = step / 8;
+        auto p = [&](double a) { return double(hgPhase(float(std::cos(a)), g)); };
+        double sum = 0;
+        for (int k = 0; k < BeamAngleSteps; ++k) {
+            for (int j = 0; j < 8; ++j) {
+                const double a = k * step + j * h;
+                sum += h / 6 * (p(a) + 4 * p(a + 0.5 * h) + p(a + h));
+            }
+            G[size_t(k + 1)] = float(sum);
+        }
+        table = std::make_unique<const std::vector<float>>(std::move(G));
+    }
+    return table.get();
+}
 
 // The beams of every region, made on a thread's first use: per region a
 // list of spots with their axial range over the region's scattering media.
@@ -37,7 +84,6 @@ void buildBeams(ThreadContext& ctx) {
         }
         if (!(depth * double(length(hull.extent())) <= MaxBeamRegionDepth)) continue;
         ThreadContext::BeamRegion& out = ctx.beamRegions[r];
-        double total = 0;
         for (size_t i = 0; i < nLights; ++i) {
             const Light& light = scene.lights[i];
             if (light.desc().type != LightDesc::Type::Spot || !ctx.lightDistanceCandidate[r * nLights + i]) continue;
@@ -60,14 +106,14 @@ void buildBeams(ThreadContext& ctx) {
             b.s0 = std::max(s0, 1e-4f * std::max(scene.sceneScale, 1e-6f));
             b.s1 = s1;
             if (!(b.s1 > b.s0)) continue;
-            // Chosen in proportion to the beam's power per unit length.
-            b.choice = std::max(average(light.desc().intensity), 0.f) * (1 - b.cosCone);
-            if (!(b.choice > 0)) continue;
-            total += b.choice;
+            // The power it scatters per unit length (the choice between
+            // beams weighs it by the vertex's view, BeamView).
+            b.power = std::max(average(light.desc().intensity), 0.f) * (1 - b.cosCone);
+            if (!(b.power > 0)) continue;
             coordinateSystem(b.axis, b.e1, b.e2);
             out.beams.push_back(b);
         }
-        for (ThreadContext::Beam& b : out.beams) b.choice = float(b.choice / total);
+        if (!out.beams.empty()) out.angleIntegral = phaseAngleIntegral(regionPhaseG(scene, int(r)));
     }
 }
 
@@ -94,10 +140,82 @@ double inverseSquareMoment(double sx, double c, double ta, double tb) {
     return sum * half;
 }
 
-// The density of directions towards beam b from x (solid angle): the
-// volume density 1 / ((s1 - s0) pi tan^2 s^2) integrated along the ray over
-// the cone's part in [s0, s1], with the Jacobian t^2.
-double beamPdf(ThreadContext& ctx, const ThreadContext::Beam& b, const Vec3& x, const Vec3& wi) {
+// One beam as a vertex at x sees it. The axial density of its points is
+// proportional to the beam's phase towards x times the inverse square of
+// the distance (the light a point scatters towards x, per unit length of
+// axis; the cone's disc area cancels the spot's 1/s^2). With theta(s) the
+// angle at the axis point s between the beam's travel and the way to x,
+// theta = atan2(h, sx - s) for x at axial position sx and distance h from
+// the axis, that product is p(cos theta) d theta / h: its integral over an
+// axial range is a difference of G(theta), the phase integrated over the
+// angle (tabulated per region). The axial density is piecewise constant on
+// BeamBins bins, each bin's mass from G at its ends, so that a direction's
+// density keeps a closed form per bin (inverseSquareMoment).
+// atan2(y, x) for y >= 0, in [0, pi], to about 1e-5: the axial density
+// only needs the same function wherever it is evaluated.
+inline double angleAt(double y, double x) {
+    const double ax = std::fabs(x), big = std::max(ax, y), small = std::min(ax, y);
+    if (!(big > 0)) return 0;
+    const double a = small / big, q = a * a;
+    double r = ((-0.0464964749 * q + 0.15931422) * q - 0.327622764) * q * a + a;
+    if (y > ax) r = 0.5 * PiD - r;
+    return x < 0 ? PiD - r : r;
+}
+
+struct BeamView {
+    const ThreadContext::Beam* beam = nullptr;
+    const std::vector<float>* G = nullptr;
+    BeamMixture::Sight sight;
+
+    BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, const BeamMixture::Sight& s)
+        : beam(&b), G(&table), sight(s) {}
+    BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, const Vec3& x) : beam(&b), G(&table) {
+        const Vec3 v = x - b.apex;
+        sight.sx = double(dot(v, b.axis));
+        // Off the axis by at least the disc's radius at the range's start:
+        // bounded weights for a vertex on the axis.
+        sight.h = std::max(double(length(v - b.axis * float(sight.sx))), double(b.tanCone) * double(b.s0));
+        sight.g0 = angleIntegralAt(0);
+        sight.g1 = angleIntegralAt(BeamBins);
+        sight.weight = sight.g1 > sight.g0 ? double(b.power) * (sight.g1 - sight.g0) / sight.h : 0;
+    }
+    double weight() const { return sight.weight; }
+    double edge(int i) const {
+        const double s0 = beam->s0, s1 = beam->s1;
+        return i >= BeamBins ? s1 : s0 + (s1 - s0) * i / BeamBins;
+    }
+    // G at bin edge i, linear between the table's angles.
+    double angleIntegralAt(int i) const {
+        const double f = std::clamp(angleAt(sight.h, sight.sx - edge(i)) / PiD, 0.0, 1.0) * BeamAngleSteps;
+        const int k = std::min(int(f), BeamAngleSteps - 1);
+        const std::vector<float>& t = *G;
+        return double(t[size_t(k)]) + (f - k) * double(t[size_t(k + 1)] - t[size_t(k)]);
+    }
+};
+
+// Beam k as the mixture's vertex sees it: from the sights made once per
+// vertex (the first MaxSights beams), or made now.
+BeamView viewOf(const BeamMixture& m, size_t k) {
+    const ThreadContext::BeamRegion& r = m.ctx->beamRegions[size_t(m.region)];
+    if (m.mBeamWeight < 0) {
+        double total = 0;
+        for (size_t j = 0; j < r.beams.size(); ++j) {
+            const BeamView v(r.beams[j], *r.angleIntegral, m.vertex->p);
+            if (j < size_t(BeamMixture::MaxSights)) m.mSights[j] = v.sight;
+            total += v.weight();
+        }
+        m.mBeamWeight = total;
+    }
+    if (k < size_t(BeamMixture::MaxSights)) return BeamView(r.beams[k], *r.angleIntegral, m.mSights[k]);
+    return BeamView(r.beams[k], *r.angleIntegral, m.vertex->p);
+}
+
+// The density of directions towards the beam of `view` from x (solid
+// angle): per bin, its mass times the volume density 1 / (bin length x pi
+// tan^2 s^2) integrated along the ray over the cone's part in the bin, with
+// the Jacobian t^2.
+double beamPdf(ThreadContext& ctx, const BeamView& view, const Vec3& x, const Vec3& wi) {
+    const ThreadContext::Beam& b = *view.beam;
     float t0, t1;
     if (!lightReach(ctx, b.light, Ray{x, wi}, t0, t1)) return 0;
     const double sx = double(dot(x - b.apex, b.axis)), c = double(dot(wi, b.axis));
@@ -112,8 +230,42 @@ double beamPdf(ThreadContext& ctx, const ThreadContext::Beam& b, const Vec3& x, 
     }
     ta = std::max(ta, 0.0);
     if (!(tb > ta) || std::isinf(tb)) return 0;
-    const double norm = double(b.s1 - b.s0) * PiD * double(b.tanCone) * double(b.tanCone);
-    return inverseSquareMoment(sx, c, ta, tb) / norm;
+    // The bins the chord crosses, from its axial ends.
+    const double sa = std::fabs(c) < 1e-12 ? sx : sx + c * ta, sb = std::fabs(c) < 1e-12 ? sx : sx + c * tb;
+    const double len = double(b.s1 - b.s0);
+    const int i0 = std::clamp(int((std::min(sa, sb) - b.s0) / len * BeamBins), 0, BeamBins - 1);
+    const int i1 = std::clamp(int((std::max(sa, sb) - b.s0) / len * BeamBins), 0, BeamBins - 1);
+    const double mass = view.sight.g1 - view.sight.g0, area = PiD * double(b.tanCone) * double(b.tanCone);
+    double pdf = 0, gLo = view.angleIntegralAt(i0);
+    for (int i = i0; i <= i1; ++i) {
+        const double lo = view.edge(i), hi = view.edge(i + 1), gHi = view.angleIntegralAt(i + 1);
+        const double binMass = std::max(gHi - gLo, 0.0) / mass;
+        gLo = gHi;
+        if (!(binMass > 0)) continue;
+        double u = ta, v = tb;
+        if (std::fabs(c) >= 1e-12) {
+            double a0 = (lo - sx) / c, a1 = (hi - sx) / c;
+            if (a0 > a1) std::swap(a0, a1);
+            u = std::max(u, a0);
+            v = std::min(v, a1);
+        }
+        if (!(v > u)) continue;
+        pdf += binMass * inverseSquareMoment(sx, c, u, v) / ((hi - lo) * area);
+    }
+    return pdf;
+}
+
+// The views of a region's beams from x, and the sum of their weights.
+template <typename F>
+double forEachBeamView(const ThreadContext& ctx, int region, const Vec3& x, F&& f) {
+    const ThreadContext::BeamRegion& r = ctx.beamRegions[size_t(region)];
+    double total = 0;
+    for (const ThreadContext::Beam& b : r.beams) {
+        const BeamView view(b, *r.angleIntegral, x);
+        total += view.weight();
+        f(view);
+    }
+    return total;
 }
 
 }  // namespace
@@ -126,13 +278,27 @@ bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLight
 
 float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi) {
     double pdf = 0;
-    for (const ThreadContext::Beam& b : ctx.beamRegions[size_t(region)].beams)
-        pdf += double(b.choice) * beamPdf(ctx, b, x, wi);
-    return float(pdf);
+    const double total = forEachBeamView(ctx, region, x, [&](const BeamView& view) {
+        if (view.weight() > 0) pdf += view.weight() * beamPdf(ctx, view, x, wi);
+    });
+    return total > 0 ? float(pdf / total) : 0.f;
+}
+
+double BeamMixture::beamWeight() const {
+    if (mBeamWeight < 0) viewOf(*this, 0);
+    return mBeamWeight;
 }
 
 float BeamMixture::pdf(const Vec3& wi) const {
-    return (1 - BeamShare) * vertex->fPdf(wi) + BeamShare * beamDirectionPdf(*ctx, region, vertex->p, wi);
+    // A vertex that sees no beam (every view's weight zero) keeps f alone.
+    if (!(beamWeight() > 0)) return vertex->fPdf(wi);
+    const size_t n = ctx->beamRegions[size_t(region)].beams.size();
+    double beams = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const BeamView view = viewOf(*this, k);
+        if (view.weight() > 0) beams += view.weight() * beamPdf(*ctx, view, vertex->p, wi);
+    }
+    return (1 - BeamShare) * vertex->fPdf(wi) + BeamShare * float(beams / mBeamWeight);
 }
 
 Vec3 BeamMixture::sample(Rng& rng, Color& weight, float& pdfOut) const {
@@ -140,16 +306,38 @@ Vec3 BeamMixture::sample(Rng& rng, Color& weight, float& pdfOut) const {
     const float u = rng.uniform();
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
     Vec3 wi;
-    if (u < BeamShare) {
-        // A beam, a point along its axis, a point on the cone's disc there.
-        const std::vector<ThreadContext::Beam>& beams = ctx->beamRegions[size_t(region)].beams;
+    if (u < BeamShare && beamWeight() > 0) {
+        // A beam by its weight, a bin by its mass (a search on G at the
+        // bins' edges), a point along the bin, a point on the disc there.
+        const ThreadContext::BeamRegion& r = ctx->beamRegions[size_t(region)];
+        double pick = double(u0) * beamWeight();
         size_t k = 0;
-        for (float cdf = beams[0].choice; k + 1 < beams.size() && !(u0 < cdf); cdf += beams[++k].choice) {
+        for (; k + 1 < r.beams.size(); ++k) {
+            const double w = viewOf(*this, k).weight();
+            if (pick < w) break;
+            pick -= w;
         }
-        const ThreadContext::Beam& b = beams[k];
-        const float s = b.s0 + u1 * (b.s1 - b.s0);
-        const float r = s * b.tanCone * std::sqrt(u2), phi = 2 * Pi * rng.uniform();
-        const Vec3 to = b.apex + b.axis * s + (b.e1 * std::cos(phi) + b.e2 * std::sin(phi)) * r - v.p;
+        BeamView view = viewOf(*this, k);
+        while (!(view.weight() > 0) && k > 0) view = viewOf(*this, --k);
+        const ThreadContext::Beam& b = r.beams[k];
+        const double target = view.sight.g0 + double(u1) * (view.sight.g1 - view.sight.g0);
+        int lo = 0, hi = BeamBins;  // G(edge lo) <= target < G(edge hi)
+        double gLo = view.sight.g0, gHi = view.sight.g1;
+        while (hi - lo > 1) {
+            const int mid = (lo + hi) / 2;
+            const double gm = view.angleIntegralAt(mid);
+            if (target < gm) {
+                hi = mid;
+                gHi = gm;
+            } else {
+                lo = mid;
+                gLo = gm;
+            }
+        }
+        const double along = gHi > gLo ? std::clamp((target - gLo) / (gHi - gLo), 0.0, 1.0) : 0.5;
+        const float s = float(view.edge(lo) + along * (view.edge(lo + 1) - view.edge(lo)));
+        const float rad = s * b.tanCone * std::sqrt(u2), phi = 2 * Pi * rng.uniform();
+        const Vec3 to = b.apex + b.axis * s + (b.e1 * std::cos(phi) + b.e2 * std::sin(phi)) * rad - v.p;
         const float len = length(to);
         if (!(len > 0)) {
             pdfOut = 0;

@@ -6,12 +6,14 @@
 // cosine-sampled direction crosses one rarely, and the
 // distance samples towards the light (light_distance.h) only pay on the
 // segments that do. So with probability BeamShare a vertex draws a point
-// in a beam instead, uniform along the spot's axis over the axial range of
-// the region's scattering media and uniform over the cone's disc there
-// (the scattered power per unit length of a beam is about constant: the
-// falloff 1/s^2 and the disc's area s^2 cancel), and goes towards it. The
+// in a beam instead and goes towards it: along the spot's axis over the
+// axial range of the region's scattering media, in proportion to what each
+// part of the axis scatters towards the vertex (the beam's power per unit
+// length, about constant since the falloff 1/s^2 and the disc's area s^2
+// cancel, times the phase towards the vertex over the squared distance;
+// piecewise constant on bins), and uniform over the cone's disc there. The
 // density of that direction is the volume density integrated along the ray
-// (times t^2), in closed form (beamDirectionPdf). The vertex weighs by the
+// (times t^2), in closed form per bin (beamDirectionPdf). The vertex weighs by the
 // one-sample mixture, f / ((1 - p) p_phase + p p_beams), so the estimate
 // is unbiased for any beams and lights, and next-event estimation meets the
 // same density by MIS (ScatterVertex::pathPdf).
@@ -48,6 +50,18 @@ struct BeamMixture {
     // pdf 0 (weight 0): no direction.
     Vec3 sample(Rng& rng, Color& weight, float& pdf) const;
     float pdf(const Vec3& wi) const;
+    // The sum of the beams' weights as the vertex sees them (0: f alone).
+    double beamWeight() const;
+
+    // How the vertex sees each of the first MaxSights beams (its axial
+    // position, distance from the axis, the phase's angle integral at the
+    // beam's ends, and the beam's weight), computed once per vertex.
+    struct Sight {
+        double sx = 0, h = 1, g0 = 0, g1 = 0, weight = 0;
+    };
+    static constexpr int MaxSights = 4;
+    mutable Sight mSights[MaxSights];
+    mutable double mBeamWeight = -1;  // beamWeight(); < 0 until the sights are made
     // For ScatterVertex::pathPdf.
     static float pdfOf(const void* self, const Vec3& wi) { return static_cast<const BeamMixture*>(self)->pdf(wi); }
 

@@ -60,11 +60,15 @@ struct ThreadContext {
         int light;
         Vec3 apex, axis, e1, e2;
         float tanCone, cosCone;
-        float s0, s1;      // the axial range sampled (the region's media)
-        float choice = 1;  // probability of this beam
+        float s0, s1;     // the axial range sampled (the region's media)
+        float power = 1;  // scattered power per unit length of beam
     };
     struct BeamRegion {
         std::vector<Beam> beams;
+        // The integral of the media's phase function over the scattering
+        // angle, G(theta) = int_0^theta p(cos a) da, at BeamAngleSteps + 1
+        // angles over [0, pi] (beam_directions.cpp, shared by all threads).
+        const std::vector<float>* angleIntegral = nullptr;
     };
     std::vector<BeamRegion> beamRegions;
     RenderCounters counters;
