@@ -194,7 +194,8 @@ TEST(EmptySpace, MarchSamplesDoNotGrowWithTheBoundingBox) {
     EXPECT_EQ(a.shadowSamples, b.shadowSamples);
 }
 
-// A time budget renders whole sweeps of one sample per pixel; the image is the
+// A time budget renders whole sweeps of samples per pixel (one, then as many
+// as fill a tenth of a second, ending at photon passes); the image is the
 // same, bit for bit, as a render of that many samples per pixel (for guided,
 // the cache lookups along a ray must not depend on earlier rays).
 class TimeBudget : public ::testing::TestWithParam<std::tuple<Method, LiSource>> {};
