@@ -94,7 +94,7 @@ void buildBeams(ThreadContext& ctx) {
             const double cone = double(light.desc().coneDeg) * (PiD / 180);
             if (!(cone > 0 && cone < 0.5 * PiD * 0.99)) continue;
             b.tanCone = float(std::tan(cone));
-            b.cosCone = float(std::cos(cone));
+            const float cosCone = float(std::cos(cone));
             // The axial range of the hull: its corners' projections.
             float s0 = Infinity, s1 = -Infinity;
             for (int c = 0; c < 8; ++c) {
@@ -108,7 +108,7 @@ void buildBeams(ThreadContext& ctx) {
             if (!(b.s1 > b.s0)) continue;
             // The power it scatters per unit length (the choice between
             // beams weighs it by the vertex's view, BeamView).
-            b.power = std::max(average(light.desc().intensity), 0.f) * (1 - b.cosCone);
+            b.power = std::max(average(light.desc().intensity), 0.f) * (1 - cosCone);
             if (!(b.power > 0)) continue;
             coordinateSystem(b.axis, b.e1, b.e2);
             out.beams.push_back(b);

@@ -59,7 +59,7 @@ struct ThreadContext {
     struct Beam {
         int light;
         Vec3 apex, axis, e1, e2;
-        float tanCone, cosCone;
+        float tanCone;
         float s0, s1;     // the axial range sampled (the region's media)
         float power = 1;  // scattered power per unit length of beam
     };
