@@ -63,8 +63,20 @@ int glassSphereOf(const Scene& scene, int surface) {
 }
 
 // Russian roulette on the throughput after RouletteMinDepth events.
-bool roulette(Color& beta, int depth, Rng& rng) {
-    return depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold);
+bool roulette(Color& beta, const PathState& st, Rng& rng) {
+    if (st.depth < RouletteMinDepth) return true;
+    const float q = rouletteSurvival(beta * st.rouletteScale, ScatterRouletteThreshold);
+    if (q >= 1) return true;
+    if (!(q > 0) || rng.uniform() >= q) return false;
+    beta /= q;
+    return true;
+}
+
+// A beam mixture's direction wi of density pdf: what f's own sampling would
+// have left the throughput (PathState::rouletteScale).
+void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf) {
+    const float pf = v.fPdf(wi);
+    if (pf > 0 && pdf > 0) st.rouletteScale = std::min(st.rouletteScale * (pdf / pf), 1e20f);
 }
 
 }  // namespace
@@ -197,6 +209,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             }
             float pdf = 0;
             const Vec3 wi = sampleDirection(beta, pdf);
+            if (beamDirections) scaleRoulette(st, vertex, wi, pdf);
             startVertex(st, x, wi, pdf, caustics);
             ray = Ray{x, wi};
             return true;
@@ -243,7 +256,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         }
         if (isBlack(beta)) return result(0.f);
         if (scattered) {
-            if (!windowed && !roulette(beta, st.depth, rng)) return result(0.f);
+            if (!windowed && !roulette(beta, st, rng)) return result(0.f);
             continue;
         }
         // Reached tEnd without a real collision.
@@ -298,6 +311,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 next.d = beams.sample(rng, weight, pdf);
                 if (isBlack(weight)) return result(0.f);  // a beam below the surface
                 next.o = offsetRayOrigin(scene, h.p, vertex.arrivalNormal(), next.d);
+                scaleRoulette(st, vertex, next.d, pdf);
             }
             startVertex(st, h.p, next.d, pdf, caustics);
         } else if (!e.straight) {
@@ -314,7 +328,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         beta *= weight;
         ray = next;
         region = e.region;
-        if (e.kind == SurfaceEvent::Kind::Diffuse && !roulette(beta, st.depth, rng)) return result(0.f);
+        if (e.kind == SurfaceEvent::Kind::Diffuse && !roulette(beta, st, rng)) return result(0.f);
     }
 }
 

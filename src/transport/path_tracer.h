@@ -47,6 +47,13 @@ struct PathState {
     // split into.
     float windowReference = 0;
     int splitLimit = MaxSplitPaths;
+    // Roulette by throughput judges a path by beta x rouletteScale: the
+    // throughput it would carry had every vertex sampled f alone. A
+    // direction drawn towards a spot beam (beam_directions.h) carries the
+    // small weight f / mixture pdf because it went where the light is, and
+    // roulette by beta alone ended most such paths before their next
+    // segment crossed the beam.
+    float rouletteScale = 1;
     // Sphere caustic connections (sphere_caustics.h) were made at lastPoint,
     // and the refractions since then through one glass sphere: a sphere
     // light hit after exactly two (in and out) takes the MIS weight against

@@ -20,8 +20,10 @@ Image renderWith(const std::string& sample, const std::vector<std::string>& over
     return renderSampleToggled(sample, overrides, "render.beam_directions", beams, seed);
 }
 
+// The scene's own max_depth 8: roulette (from depth 3) is part of what the
+// beams change (PathState::rouletteScale).
 const std::vector<std::string> SpotScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
-                                            "render.max_depth=4", "render.spp=384"};
+                                            "render.max_depth=8", "render.spp=384"};
 
 TEST(BeamDirectionRenders, SpotsInHazeOverAFloorAgreeWithPhaseAndCosineAlone) {
     const Image on = renderWith("scenes/fig3b_spots.json", SpotScene, true);
@@ -61,15 +63,16 @@ TEST(BeamDirectionRenders, DenseMediaKeepTheirOwnDirections) {
 }
 
 TEST(BeamDirectionRenders, BeamDirectionsQuietTheSpotScene) {
-    // Pair MSE of two seeds, with and without: measured 0.41x at 160x120
-    // and 128 spp (BENCHMARKS.md); here at least 1/3 less.
+    // Pair MSE of two seeds, with and without: measured 0.128x here, and
+    // 0.239x before roulette judged paths by the throughput of f's sampling
+    // (PathState::rouletteScale), which this bound of 0.18x also guards.
     auto noise = [](bool beams) {
         std::vector<std::string> o = SpotScene;
-        o.back() = "render.spp=64";
+        o.back() = "render.spp=128";
         return test::pairMse(renderWith("scenes/fig3b_spots.json", o, beams, 11),
                              renderWith("scenes/fig3b_spots.json", o, beams, 23));
     };
-    EXPECT_LT(noise(true), 0.67 * noise(false));
+    EXPECT_LT(noise(true), 0.18 * noise(false));
 }
 
 }  // namespace
