@@ -72,7 +72,8 @@ bool roulette(Color& beta, const PathState& st, Rng& rng) {
     return true;
 }
 
-// A beam mixture's direction wi of density pdf: what f's own sampling would
+// A direction wi of density pdf drawn by a sampler other than f's own (a
+// beam mixture, the guide's product sampler): what f's own sampling would
 // have left the throughput (PathState::rouletteScale).
 void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf) {
     const float pf = v.fPdf(wi);
@@ -209,7 +210,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             }
             float pdf = 0;
             const Vec3 wi = sampleDirection(beta, pdf);
-            if (beamDirections) scaleRoulette(st, vertex, wi, pdf);
+            if (beamDirections || guidedDirection) scaleRoulette(st, vertex, wi, pdf);
             startVertex(st, x, wi, pdf, caustics);
             ray = Ray{x, wi};
             return true;

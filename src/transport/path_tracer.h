@@ -49,10 +49,10 @@ struct PathState {
     int splitLimit = MaxSplitPaths;
     // Roulette by throughput judges a path by beta x rouletteScale: the
     // throughput it would carry had every vertex sampled f alone. A
-    // direction drawn towards a spot beam (beam_directions.h) carries the
-    // small weight f / mixture pdf because it went where the light is, and
-    // roulette by beta alone ended most such paths before their next
-    // segment crossed the beam.
+    // direction drawn towards a spot beam (beam_directions.h) or by the
+    // guide's product sampler carries the small weight f / pdf because it
+    // went where the light is, and roulette by beta alone ended most such
+    // paths before their next segment found that light.
     float rouletteScale = 1;
     // Sphere caustic connections (sphere_caustics.h) were made at lastPoint,
     // and the refractions since then through one glass sphere: a sphere
