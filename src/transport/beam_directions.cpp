@@ -140,17 +140,6 @@ double inverseSquareMoment(double sx, double c, double ta, double tb) {
     return sum * half;
 }
 
-// One beam as a vertex at x sees it. The axial density of its points is
-// proportional to the beam's phase towards x times the inverse square of
-// the distance (the light a point scatters towards x, per unit length of
-// axis; the cone's disc area cancels the spot's 1/s^2). With theta(s) the
-// angle at the axis point s between the beam's travel and the way to x,
-// theta = atan2(h, sx - s) for x at axial position sx and distance h from
-// the axis, that product is p(cos theta) d theta / h: its integral over an
-// axial range is a difference of G(theta), the phase integrated over the
-// angle (tabulated per region). The axial density is piecewise constant on
-// BeamBins bins, each bin's mass from G at its ends, so that a direction's
-// density keeps a closed form per bin (inverseSquareMoment).
 // atan2(y, x) for y >= 0, in [0, pi], to about 1e-5: the axial density
 // only needs the same function wherever it is evaluated.
 inline double angleAt(double y, double x) {
@@ -162,6 +151,17 @@ inline double angleAt(double y, double x) {
     return x < 0 ? PiD - r : r;
 }
 
+// One beam as a vertex at x sees it. The axial density of its points is
+// proportional to the beam's phase towards x times the inverse square of
+// the distance (the light a point scatters towards x, per unit length of
+// axis; the cone's disc area cancels the spot's 1/s^2). With theta(s) the
+// angle at the axis point s between the beam's travel and the way to x,
+// theta = atan2(h, sx - s) for x at axial position sx and distance h from
+// the axis, that product is p(cos theta) d theta / h: its integral over an
+// axial range is a difference of G(theta), the phase integrated over the
+// angle (tabulated per region). The axial density is piecewise constant on
+// BeamBins bins, each bin's mass from G at its ends, so that a direction's
+// density keeps a closed form per bin (inverseSquareMoment).
 struct BeamView {
     const ThreadContext::Beam* beam = nullptr;
     const std::vector<float>* G = nullptr;
@@ -255,17 +255,18 @@ double beamPdf(ThreadContext& ctx, const BeamView& view, const Vec3& x, const Ve
     return pdf;
 }
 
-// The views of a region's beams from x, and the sum of their weights.
-template <typename F>
-double forEachBeamView(const ThreadContext& ctx, int region, const Vec3& x, F&& f) {
-    const ThreadContext::BeamRegion& r = ctx.beamRegions[size_t(region)];
-    double total = 0;
-    for (const ThreadContext::Beam& b : r.beams) {
-        const BeamView view(b, *r.angleIntegral, x);
+// The beams' density of wi from x (solid angle): each of the n beams'
+// density weighed by its share of the views' weights (viewAt(k): beam k as
+// x sees it).
+template <typename ViewAt>
+double beamsPdf(ThreadContext& ctx, size_t n, ViewAt&& viewAt, const Vec3& x, const Vec3& wi) {
+    double pdf = 0, total = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const BeamView view = viewAt(k);
         total += view.weight();
-        f(view);
+        if (view.weight() > 0) pdf += view.weight() * beamPdf(ctx, view, x, wi);
     }
-    return total;
+    return total > 0 ? pdf / total : 0.0;
 }
 
 }  // namespace
@@ -277,11 +278,9 @@ bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLight
 }
 
 float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi) {
-    double pdf = 0;
-    const double total = forEachBeamView(ctx, region, x, [&](const BeamView& view) {
-        if (view.weight() > 0) pdf += view.weight() * beamPdf(ctx, view, x, wi);
-    });
-    return total > 0 ? float(pdf / total) : 0.f;
+    const ThreadContext::BeamRegion& r = ctx.beamRegions[size_t(region)];
+    return float(beamsPdf(
+        ctx, r.beams.size(), [&](size_t k) { return BeamView(r.beams[k], *r.angleIntegral, x); }, x, wi));
 }
 
 double BeamMixture::beamWeight() const {
@@ -292,13 +291,9 @@ double BeamMixture::beamWeight() const {
 float BeamMixture::pdf(const Vec3& wi) const {
     // A vertex that sees no beam (every view's weight zero) keeps f alone.
     if (!(beamWeight() > 0)) return vertex->fPdf(wi);
-    const size_t n = ctx->beamRegions[size_t(region)].beams.size();
-    double beams = 0;
-    for (size_t k = 0; k < n; ++k) {
-        const BeamView view = viewOf(*this, k);
-        if (view.weight() > 0) beams += view.weight() * beamPdf(*ctx, view, vertex->p, wi);
-    }
-    return (1 - BeamShare) * vertex->fPdf(wi) + BeamShare * float(beams / mBeamWeight);
+    const double beams = beamsPdf(
+        *ctx, ctx->beamRegions[size_t(region)].beams.size(), [&](size_t k) { return viewOf(*this, k); }, vertex->p, wi);
+    return (1 - BeamShare) * vertex->fPdf(wi) + BeamShare * float(beams);
 }
 
 Vec3 BeamMixture::sample(Rng& rng, Color& weight, float& pdfOut) const {

@@ -42,6 +42,7 @@ float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3
 // A vertex's direction sampler: f's own sampling (the phase function, or
 // the cosine on a diffuse surface) mixed with the beams.
 struct BeamMixture {
+    BeamMixture(ThreadContext* c, int r, const ScatterVertex* v) : ctx(c), region(r), vertex(v) {}
     ThreadContext* ctx;
     int region;
     const ScatterVertex* vertex;

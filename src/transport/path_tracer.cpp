@@ -64,12 +64,7 @@ int glassSphereOf(const Scene& scene, int surface) {
 
 // Russian roulette on the throughput after RouletteMinDepth events.
 bool roulette(Color& beta, const PathState& st, Rng& rng) {
-    if (st.depth < RouletteMinDepth) return true;
-    const float q = rouletteSurvival(beta * st.rouletteScale, ScatterRouletteThreshold);
-    if (q >= 1) return true;
-    if (!(q > 0) || rng.uniform() >= q) return false;
-    beta /= q;
-    return true;
+    return st.depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold, st.rouletteScale);
 }
 
 // A direction wi of density pdf drawn by a sampler other than f's own (a

@@ -29,9 +29,12 @@ inline float rouletteSurvival(const Color& beta, float threshold = RouletteThres
 }
 
 // Draws a uniform only when the throughput is below the threshold; divides
-// beta by the survival probability. Returns false when the path ends.
-inline bool russianRoulette(Color& beta, Rng& rng, float threshold = RouletteThreshold) {
-    const float q = rouletteSurvival(beta, threshold);
+// beta by the survival probability. Returns false when the path ends. The
+// path is judged by beta x judgedScale (PathState::rouletteScale: the
+// throughput f's own sampling would have left it); any survival
+// probability keeps the estimate unbiased.
+inline bool russianRoulette(Color& beta, Rng& rng, float threshold = RouletteThreshold, float judgedScale = 1) {
+    const float q = rouletteSurvival(beta * judgedScale, threshold);
     if (q >= 1) return true;
     if (!(q > 0) || rng.uniform() >= q) return false;
     beta /= q;

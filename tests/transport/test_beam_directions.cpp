@@ -90,7 +90,9 @@ TEST_P(BeamDirections, SamplerMatchesItsPdf) {
     }
     EXPECT_EQ(mismatches, 0);
     EXPECT_EQ(badWeights, 0);
-    if (!c.surface) EXPECT_EQ(zero, 0);
+    if (!c.surface) {
+        EXPECT_EQ(zero, 0);
+    }
     std::vector<double> x, w;
     gaussLegendre(6, x, w);
     const double dz = 2.0 / nz, dp = 2 * PiD / np;
@@ -111,8 +113,9 @@ TEST_P(BeamDirections, SamplerMatchesItsPdf) {
             total += mass;
         }
     // The share of samples below a surface is what the density leaves there.
-    if (c.surface)
+    if (c.surface) {
         EXPECT_NEAR(zero / double(samples), 1 - total, 4 * std::sqrt((1 - total) * total / samples) + 2e-3);
+    }
     const test::ChiSquare chi = test::pooledChiSquare(observed, expected, 5);
     std::printf("[ chi2     ] %-24s chi2 %.1f dof %d p %.3f\n", c.name, chi.chi2, chi.dof, chi.p());
     ASSERT_GT(chi.dof, 1000);
