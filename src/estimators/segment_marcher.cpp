@@ -76,7 +76,16 @@ PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext
         const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            const Color Ld = beta * directLight(ctx, region, ScatterVertex::onSurface(h.p, ray.d, h.n, albedo), rng, {});
+            const ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
+            Color Ld = beta * directLight(ctx, region, vertex, rng, {});
+            // Light through glass spheres (sphere_caustics.h): point and spot
+            // lights, which no path finds; sphere lights too where max_depth
+            // ends the path here, else the path below finds them.
+            if (regionHasSphereCaustics(scene, region)) {
+                const bool last = diffuseBounces + 1 >= scene.desc.render.maxDepth;
+                Ld += beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching,
+                                                {last, true, !last});
+            }
             L += Ld;
             if (mTallyDirect && diffuseBounces == 0) scratch(ctx).direct += Ld;
             // Light that reaches the surface after scattering in a medium
@@ -169,7 +178,8 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     // continuation's own hits (transport/sphere_caustics.h).
     const bool caustics = regionHasSphereCaustics(mScene, region);
     if (caustics) {
-        const Color Lc = sphereCausticLight(ctx, region, nextEventVertex, rng, TransmittanceEstimator::UnbiasedMarching);
+        const Color Lc = sphereCausticLight(ctx, region, nextEventVertex, rng, TransmittanceEstimator::UnbiasedMarching,
+                                            {true, !il.pointLightsByPhotons, true});
         Li += Lc;
         if (tallyHere) m.liDirect += Lc;
     }

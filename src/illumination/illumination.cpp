@@ -217,7 +217,9 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     }
     if (rs.li == LiSource::Photons) rq.indirect = rs.maxDepth > 1 || bendingGlass;
     if (rs.li == LiSource::Path) {
-        rq.indirect = (bendingGlass && deltaLight) || (pointLight && rs.maxDepth > 1);
+        // Caustics of point and spot lights through glass spheres come from
+        // sphere caustic connections where Scene::pointLightCaustics holds.
+        rq.indirect = (bendingGlass && deltaLight && !scene.pointLightCaustics) || (pointLight && rs.maxDepth > 1);
         rq.causticsOnly = true;
         rq.pointLightsByPhotons = pointLight && rq.indirect;
     }

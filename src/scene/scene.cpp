@@ -77,6 +77,27 @@ void findGlassSpheres(Scene& scene) {
     }
 }
 
+// Scene::pointLightCaustics.
+bool connectsPointLightCaustics(const Scene& scene) {
+    if (!scene.desc.render.sphereCaustics) return false;
+    for (size_t i = 0; i < scene.surfaces.size(); ++i) {
+        const SurfaceInfo& info = scene.surfaces[i];
+        if (info.material.type != MaterialDesc::Type::Dielectric || crossedByShadowRays(info.material)) continue;
+        bool sphere = false;
+        for (const GlassSphere& g : scene.glassSpheres) sphere = sphere || g.surface == int(i);
+        if (!sphere) return false;
+    }
+    bool pointLike = false;
+    for (const Light& l : scene.lights) {
+        if (!l.isDelta()) continue;
+        if (!l.isPointLike()) return false;
+        pointLike = true;
+        for (const GlassSphere& g : scene.glassSpheres)
+            if (!(length(l.desc().position - g.center) > g.radius)) return false;
+    }
+    return pointLike;
+}
+
 // Scene::shadowRaysCanReach. A region is sealed when every surface that
 // names it is closed, blocks shadow rays and has it as its interior (so the
 // region lies inside those surfaces, bounded); a light is then out of reach
@@ -248,6 +269,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     scene->shadowStep = desc.render.shadowStep > 0 ? desc.render.shadowStep : scene->step;
     computeShadowReach(*scene);
     findGlassSpheres(*scene);
+    scene->pointLightCaustics = connectsPointLightCaustics(*scene);
     return scene;
 }
 

@@ -116,7 +116,9 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     auto nextEvent = [&](const ScatterVertex& vertex, const float* lightWeights) {
         add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, lightWeights)), st.depth);
         if (!regionHasSphereCaustics(scene, region)) return false;
-        add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching), st.depth);
+        add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching,
+                                              {true, !st.pointLightsByPhotons, true}),
+            st.depth);
         return true;
     };
     while (true) {

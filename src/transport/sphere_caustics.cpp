@@ -226,7 +226,7 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
 }
 
 bool regionHasSphereCaustics(const Scene& scene, int region) {
-    if (!scene.hasSphereLights || !scene.desc.render.sphereCaustics) return false;
+    if (!(scene.hasSphereLights || scene.pointLightCaustics) || !scene.desc.render.sphereCaustics) return false;
     for (const GlassSphere& s : scene.glassSpheres)
         if (s.outside == region) return true;
     return false;
@@ -280,7 +280,7 @@ double power3(double a, double b, double c) {
 }  // namespace
 
 Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
-                         TransmittanceEstimator estimator) {
+                         TransmittanceEstimator estimator, const CausticLights& lights) {
     const Scene& scene = ctx.scene;
     Color L(0);
     const Vec3 origin = v.shadowOrigin(scene);
@@ -307,7 +307,27 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             return T * shadowTransmittance(ctx, s.outside, o2, cn.wo, length(y - o2), rng, estimator);
         };
         for (const Light& light : scene.lights) {
-            if (!lightOutside(s, light)) continue;
+            if (light.isPointLike()) {
+                if (!scene.pointLightCaustics || !lights.pointLights) continue;
+                // Every root to the light's one point y: f I T (1 - F1)(1 - F2) / G.
+                const Vec3 y = light.desc().position;
+                const int n = connectThroughSphere(s, v.p, y, roots);
+                for (int k = 0; k < n; ++k) {
+                    const SphereConnection& cn = roots[k];
+                    if (!(cn.spreading > 0)) continue;
+                    // The intensity towards p2 (a spot's cone and falloff).
+                    LightSample ls;
+                    if (!light.sample(cn.p2, 0.f, 0.f, ls)) continue;
+                    const Color f = v.f(cn.wi);
+                    if (isBlack(f) || isBlack(ls.L)) continue;
+                    const Color T = throughBall(cn, y);
+                    if (isBlack(T)) continue;
+                    const double d2 = double(ls.dist) * double(ls.dist);
+                    L += f * ls.L * T * float(d2 * double(cn.transmission) / cn.spreading);
+                }
+                continue;
+            }
+            if (!lights.sphereLights || !lightOutside(s, light)) continue;
             const Vec3 lc = light.desc().position;
             const float rl = light.desc().radius;
             // 1. Connections: y uniform on the light's surface.
@@ -324,7 +344,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                 const Color T = throughBall(cn, y);
                 if (isBlack(T)) continue;
                 const double pm = pA * cn.spreading / cosY;  // solid-angle density at x
-                const double pu = double(v.pdf(cn.wi)) * double(cn.transmission);
+                const double pu = lights.pathFollows ? double(v.pdf(cn.wi)) * double(cn.transmission) : 0.0;
                 L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pm, pu, pc) / pm);
             }
             // 2. A direction uniform in the ball's cone, traced through it:
@@ -344,7 +364,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             const Color T = throughBall(cn, yHit);
             if (isBlack(T)) continue;
             const double pm = connectionPdf(s, light, v.p, cn.wi, yHit);
-            const double pu = double(v.pdf(cn.wi)) * double(cn.transmission);
+            const double pu = lights.pathFollows ? double(v.pdf(cn.wi)) * double(cn.transmission) : 0.0;
             L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pc, pm, pu) / pc);
         }
     }

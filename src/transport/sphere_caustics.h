@@ -20,6 +20,11 @@
 // the traced rays in double precision. Its solid-angle density at x is
 // p_m = p_A G / |cos theta_y|.
 //
+// A point or spot light (Scene::pointLightCaustics) is its one point y:
+// each root brings f(w) I(y -> p2) T (1 - F1)(1 - F2) / G, the limit of the
+// above for a sphere light of intensity I shrunk to a point; no path or cone
+// direction can hit it, so there is nothing to weigh it against.
+//
 // Near the lens's focus G goes to 0 and these estimates grow without bound;
 // there a direction drawn uniformly in the cone the ball subtends (density
 // p_c), traced through it, finds the light often. A path that samples its
@@ -59,12 +64,22 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, Sph
 // ray misses the sphere.
 bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out);
 
-// The caustic light at vertex v (in `region`) from every sphere light
-// through every glass sphere: the connections to one light point and one
-// direction in the ball's cone, each weighed against the other and the
-// path's own hits of sphere lights (sphereCausticPathWeight).
+// Which lights sphereCausticLight connects to, and whether the path goes on
+// from the vertex (its hits of sphere lights through the glass then weigh
+// against the connections, sphereCausticPathWeight; else the connections
+// and the cone directions share the light between them alone).
+struct CausticLights {
+    bool sphereLights = true;
+    bool pointLights = true;  // where Scene::pointLightCaustics holds
+    bool pathFollows = true;
+};
+
+// The caustic light at vertex v (in `region`) through every glass sphere:
+// from sphere lights, the connections to one light point and one direction
+// in the ball's cone, each weighed against the other and the path's own
+// hits; from point and spot lights, the connections to their point.
 Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
-                         TransmittanceEstimator estimator);
+                         TransmittanceEstimator estimator, const CausticLights& lights = {});
 
 // The power-heuristic weight of a path that left x along w (its direction
 // density pathPdf), refracted into and out of glass sphere `sphere` and hit
@@ -74,7 +89,8 @@ float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const V
                               const Vec3& y);
 
 // True when sphere caustic connections apply at a vertex in `region`
-// (render.sphere_caustics, a sphere light, a glass sphere around the region).
+// (render.sphere_caustics, a sphere light or Scene::pointLightCaustics, a
+// glass sphere around the region).
 bool regionHasSphereCaustics(const Scene& scene, int region);
 
 }  // namespace vdbmarch
