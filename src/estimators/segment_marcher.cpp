@@ -175,11 +175,12 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         product = &m.productSampler;
     Color Li = direct(directLight(ctx, region, nextEventVertex, rng, kNextEvent));
     // Sphere lights through glass spheres too, weighed against the
-    // continuation's own hits (transport/sphere_caustics.h).
+    // continuation's own hits, and point and spot lights, whose photons
+    // then leave these caustics out (transport/sphere_caustics.h,
+    // Photon::Connected).
     const bool caustics = regionHasSphereCaustics(mScene, region);
     if (caustics) {
-        const Color Lc = sphereCausticLight(ctx, region, nextEventVertex, rng, TransmittanceEstimator::UnbiasedMarching,
-                                            {true, !il.pointLightsByPhotons, true});
+        const Color Lc = sphereCausticLight(ctx, region, nextEventVertex, rng, TransmittanceEstimator::UnbiasedMarching);
         Li += Lc;
         if (tallyHere) m.liDirect += Lc;
     }

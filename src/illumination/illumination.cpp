@@ -35,6 +35,7 @@ namespace {
 
 // The photons L_i takes beside shadow rays (see IlluminationRequest).
 bool wantedInMap(const Photon& p, const IlluminationRequest& rq) {
+    if (rq.exceptConnected && p.isConnected()) return false;
     return rq.causticsOnly ? p.isCaustic() || (p.isFromPointLight() && !p.isDirect()) : !p.isDirect();
 }
 
@@ -221,6 +222,7 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
         // sphere caustic connections where Scene::pointLightCaustics holds.
         rq.indirect = (bendingGlass && deltaLight && !scene.pointLightCaustics) || (pointLight && rs.maxDepth > 1);
         rq.causticsOnly = true;
+        rq.exceptConnected = scene.pointLightCaustics;
         rq.pointLightsByPhotons = pointLight && rq.indirect;
     }
     return rq;

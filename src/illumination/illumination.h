@@ -19,8 +19,11 @@ namespace vdbmarch {
 struct IlluminationRequest {
     bool indirect = false;     // the map of photons for L_i beside shadow rays (and paths)
     // render.li = "path": only the caustic photons, and the non-direct ones
-    // of point and spot lights.
+    // of point and spot lights; without those sphere caustic connections
+    // find at the marchers' L_i samples (Photon::Connected) when
+    // exceptConnected.
     bool causticsOnly = false;
+    bool exceptConnected = false;
     bool cache = false;        // the radiance cache
     bool keepAllPhotons = false;  // keep the map of every photon (bake, tests)
     PhotonSettings photons;

@@ -49,16 +49,21 @@ struct Photon {
         Caustic = 2u,  // from a delta light through a bending surface before any scattering:
                        // no path with next-event estimation finds this light
         FromPointLight = 4u,  // emitted by a point or spot light
+        // A caustic that sphere caustic connections find (Scene::pointLightCaustics):
+        // from a point or spot light through exactly one glass sphere, in and
+        // out, with no other event before it landed.
+        Connected = 8u,
     };
     Vec3 position;
     uint32_t direction;  // encodeDirection(travel direction)
     Color weight;        // Phi / sigma_t at the collision (W m), per channel
-    uint32_t flags;      // bit 0: Direct; bit 1: Caustic; bit 2: FromPointLight; bits 16-31: the phase g there, as int16 / 32767
+    uint32_t flags;      // bits 0-3: Flags; bits 16-31: the phase g there, as int16 / 32767
 
     Vec3 travelDirection() const { return decodeDirection(direction); }
     bool isDirect() const { return (flags & Direct) != 0; }
     bool isCaustic() const { return (flags & Caustic) != 0; }
     bool isFromPointLight() const { return (flags & FromPointLight) != 0; }
+    bool isConnected() const { return (flags & Connected) != 0; }
     // Mean cosine of the phase function where the photon landed (the
     // sigma_s-weighted mean over the media there), for eq. 27's w'_l = g^l.
     float g() const { return float(int16_t(uint16_t(flags >> 16))) / 32767.f; }

@@ -90,6 +90,10 @@ private:
         int region = regionAtRayStart(scene, ray);
         int depth = 0, surfaceBounces = 0;
         bool caustic = false;  // bent before its first scattering event, from a delta light
+        // The events since emission while nothing scattered the photon:
+        // refractions into and out of one glass sphere (Photon::Connected
+        // after exactly two), -1 once anything else happened.
+        int lensSphere = -1, lensRefractions = mScene.pointLightCaustics && src.pointLight ? 0 : -1;
         Color beta(1);  // throughput relative to the emitted power
         MediumPoint mp;
         while (true) {
@@ -114,7 +118,8 @@ private:
                 float w[2];
                 mp.phase.legendreWeights(1, w);
                 ph.flags = Photon::packFlags((direct ? Photon::Direct : 0u) | (caustic ? Photon::Caustic : 0u) |
-                                                 (src.pointLight ? Photon::FromPointLight : 0u),
+                                                 (src.pointLight ? Photon::FromPointLight : 0u) |
+                                                 (lensRefractions == 2 ? Photon::Connected : 0u),
                                              w[1]);
                 out.push_back(ph);
                 if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
@@ -126,6 +131,7 @@ private:
                 const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
                 ray = Ray{x, mp.phase.sample(ray.d, u0, u1, u2, beta, pdf)};
                 direct = false;
+                lensRefractions = -1;
                 scattered = true;
                 return false;
             });
@@ -147,6 +153,12 @@ private:
                 // scattering vertex, through straight shadow rays.
                 if (direct && src.deltaLight && e.kind != SurfaceEvent::Kind::Diffuse) caustic = true;
                 direct = false;
+                const int sphere = e.kind == SurfaceEvent::Kind::Refract ? glassSphereOf(scene, h.surface) : -1;
+                if (sphere < 0 || (lensSphere >= 0 && sphere != lensSphere)) lensRefractions = -1;
+                else if (lensRefractions >= 0) {
+                    lensSphere = sphere;
+                    ++lensRefractions;
+                }
             }
             if (!russianRoulette(beta, rng, ScatterRouletteThreshold)) return;
             ray = e.ray;

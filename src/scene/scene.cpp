@@ -11,6 +11,12 @@ bool crossedByShadowRays(const MaterialDesc& m) {
     return m.type == MaterialDesc::Type::Interface || (m.type == MaterialDesc::Type::Dielectric && m.ior == 1.f);
 }
 
+int glassSphereOf(const Scene& scene, int surface) {
+    for (size_t i = 0; i < scene.glassSpheres.size(); ++i)
+        if (scene.glassSpheres[i].surface == surface) return int(i);
+    return -1;
+}
+
 int regionAtRayStart(const Scene& scene, const Ray& r) {
     SurfaceHit h;
     if (!scene.surfaceSet->intersect(r, 0.f, Infinity, h)) return Scene::WorldRegion;

@@ -48,6 +48,10 @@ struct GlassSphere {
 // index-matched glass); every other surface blocks it.
 bool crossedByShadowRays(const MaterialDesc& material);
 
+class Scene;
+// The index in Scene::glassSpheres of surface `surface`'s glass sphere, or -1.
+int glassSphereOf(const Scene& scene, int surface);
+
 class Scene {
 public:
     static constexpr int WorldRegion = 0;

@@ -55,13 +55,6 @@ void startVertex(PathState& st, const Vec3& x, const Vec3& wi, float pdf, bool c
     st.lensRefractions = 0;
 }
 
-// The glass sphere (Scene::glassSpheres) of surface `surface`, or -1.
-int glassSphereOf(const Scene& scene, int surface) {
-    for (size_t i = 0; i < scene.glassSpheres.size(); ++i)
-        if (scene.glassSpheres[i].surface == surface) return int(i);
-    return -1;
-}
-
 // Russian roulette on the throughput after RouletteMinDepth events.
 bool roulette(Color& beta, const PathState& st, Rng& rng) {
     return st.depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold, st.rouletteScale);

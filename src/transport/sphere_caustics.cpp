@@ -70,8 +70,9 @@ bool trace(const GlassSphere& s, const D3& x, const D3& w, Traced& out) {
     return true;
 }
 
-// Bracketing grid over the outline's arc that x sees, and refinement steps.
+// Bracketing grid (cells) over the outline's arc that x sees, and refinement steps.
 constexpr int RootGrid = 24;
+constexpr int RootGridNearAxis = 4;
 constexpr int RootIterations = 40;
 
 // A direction from x matches a root when within about 1.4e-3 rad of it.
@@ -123,7 +124,8 @@ bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, Sphe
     return true;
 }
 
-int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, SphereConnection out[MaxSphereConnections]) {
+int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, SphereConnection out[MaxSphereConnections],
+                         bool thorough) {
     const D3 c(s.center), x(xf), y(yf);
     const double R = s.radius;
     const D3 cx = x - c;
@@ -175,52 +177,108 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
         return e;
     };
     auto eval = [&](double a) { return evalCS(std::cos(a), std::sin(a)); };
-    int n = 0;
-    double aPrev = 0;
-    Eval prev;
-    // The grid's angles by rotation: one sincos for the whole grid.
-    const double step = 2 * aMax / RootGrid, a0 = -aMax + 0.5 * step;
+    // The grid's angles by rotation: one sincos for the whole grid. Its
+    // points are the cells' middles; a thorough solve also takes the arc's
+    // ends, just inside the outline (where the ray grazes the ball and no
+    // refraction is defined), and where x, the centre and y are nearly in
+    // line (within about 6 degrees), where the rays through the lens's
+    // middle cross near its axis and up to three roots share a few degrees
+    // of the arc, cells RootGridNearAxis times finer.
+    const int cells = thorough && yh < 0.1 * length(cy) ? RootGrid * RootGridNearAxis : RootGrid;
+    const int N = thorough ? cells + 1 : cells;
+    const double inset = thorough ? 1e-5 * aMax : 0.0;
+    const double step = (2 * aMax - 2 * inset) / cells, a0 = -aMax + inset + (thorough ? 0.0 : 0.5 * step);
     const double cStep = std::cos(step), sStep = std::sin(step);
+    Eval grid[RootGrid * RootGridNearAxis + 1];
     double ca = std::cos(a0), sa = std::sin(a0);
-    for (int k = 0; k < RootGrid && n < MaxSphereConnections; ++k) {
-        const double a = a0 + k * step;
-        const Eval cur = evalCS(ca, sa);
+    for (int k = 0; k < N; ++k) {
+        grid[k] = evalCS(ca, sa);
         const double cNext = ca * cStep - sa * sStep;
         sa = sa * cStep + ca * sStep;
         ca = cNext;
-        if (k > 0 && prev.ok && cur.ok && (prev.h < 0) != (cur.h < 0)) {
-            // False position with the Illinois modification: the bracket
-            // stays, convergence is superlinear.
-            double lo = aPrev, hi = a, hLo = prev.h, hHi = cur.h;
-            int side = 0;
-            double root = lo;
-            for (int i = 0; i < RootIterations; ++i) {
-                root = (lo * hHi - hi * hLo) / (hHi - hLo);
-                if (!(root > std::min(lo, hi) && root < std::max(lo, hi))) root = 0.5 * (lo + hi);
-                const Eval m = eval(root);
-                if (!m.ok) break;
-                if (std::fabs(m.h) < 1e-12 * (1 + std::fabs(m.ahead)) || std::fabs(hi - lo) < 1e-13) break;
-                if ((m.h < 0) == (hLo < 0)) {
-                    lo = root;
-                    hLo = m.h;
-                    if (side == -1) hHi *= 0.5;
-                    side = -1;
-                } else {
-                    hi = root;
-                    hHi = m.h;
-                    if (side == 1) hLo *= 0.5;
-                    side = 1;
-                }
+    }
+    auto angle = [&](int k) { return a0 + k * step; };
+    int n = 0;
+    // The root in [lo, hi], where h changes sign, by false position with the
+    // Illinois modification (the bracket stays, convergence is
+    // superlinear); kept if it is a connection.
+    auto refine = [&](double lo, double hi, double hLo, double hHi) {
+        int side = 0;
+        double root = lo;
+        for (int i = 0; i < RootIterations; ++i) {
+            root = (lo * hHi - hi * hLo) / (hHi - hLo);
+            if (!(root > std::min(lo, hi) && root < std::max(lo, hi))) root = 0.5 * (lo + hi);
+            const Eval m = eval(root);
+            if (!m.ok) break;
+            if (std::fabs(m.h) < 1e-12 * (1 + std::fabs(m.ahead)) || std::fabs(hi - lo) < 1e-13) break;
+            if ((m.h < 0) == (hLo < 0)) {
+                lo = root;
+                hLo = m.h;
+                if (side == -1) hHi *= 0.5;
+                side = -1;
+            } else {
+                hi = root;
+                hHi = m.h;
+                if (side == 1) hLo *= 0.5;
+                side = 1;
             }
-            const Eval r = eval(root);
-            // A sign change behind the exit point is no connection.
-            Traced tr;
-            const D3 w = direction(root);
-            if (r.ok && r.ahead > 0 && trace(s, x, w, tr) && std::fabs(r.h) < 1e-6 * length(y - tr.p2))
-                out[n++] = toConnection(w, tr, spreading(s, x, w, y, tr));
         }
-        prev = cur;
-        aPrev = a;
+        const Eval r = eval(root);
+        // A sign change behind the exit point is no connection.
+        Traced tr;
+        const D3 w = direction(root);
+        if (n < MaxSphereConnections && r.ok && r.ahead > 0 && trace(s, x, w, tr) &&
+            std::fabs(r.h) < 1e-6 * length(y - tr.p2)) {
+            // 0 where a ray beside it misses the ball (grazing, where the
+            // Fresnel transmission vanishes): no usable connection.
+            const double G = spreading(s, x, w, y, tr);
+            if (G > 0 || !thorough) out[n++] = toConnection(w, tr, G);
+        }
+    };
+    for (int k = 1; k < N; ++k) {
+        const Eval &prev = grid[k - 1], &cur = grid[k];
+        if (!prev.ok || !cur.ok) continue;
+        if ((prev.h < 0) != (cur.h < 0)) {
+            refine(angle(k - 1), angle(k), prev.h, cur.h);
+            continue;
+        }
+        // Two roots closer than the grid's step leave no sign change: near
+        // the lens's axis, where the rays through its middle cross, they lie
+        // on either side of an extremum of h. Where |h| has a local minimum
+        // at a grid point with the same sign on both sides, find the
+        // extremum (golden section) and, if h changes sign there, both roots.
+        if (!thorough || k + 1 >= N || !grid[k + 1].ok || (grid[k + 1].h < 0) != (cur.h < 0)) continue;
+        if (!(std::fabs(cur.h) <= std::fabs(prev.h) && std::fabs(cur.h) < std::fabs(grid[k + 1].h))) continue;
+        const double sign = cur.h < 0 ? -1 : 1;
+        double lo = angle(k - 1), hi = angle(k + 1);
+        const double g = 0.5 * (std::sqrt(5.0) - 1);
+        double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
+        Eval e1 = eval(m1), e2 = eval(m2);
+        // To a thousandth of the step: a pair closer than that carries a
+        // vanishing share of the light (G -> 0 where two roots merge only
+        // as the square root of the distance to the fold).
+        for (int i = 0; i < RootIterations && e1.ok && e2.ok && hi - lo > 1e-3 * step; ++i) {
+            if (sign * e1.h < sign * e2.h) {
+                hi = m2;
+                m2 = m1;
+                e2 = e1;
+                m1 = hi - g * (hi - lo);
+                e1 = eval(m1);
+            } else {
+                lo = m1;
+                m1 = m2;
+                e1 = e2;
+                m2 = lo + g * (hi - lo);
+                e2 = eval(m2);
+            }
+            if ((e1.ok && (e1.h < 0) != (cur.h < 0)) || (e2.ok && (e2.h < 0) != (cur.h < 0))) break;
+        }
+        const bool firstFlips = e1.ok && (e1.h < 0) != (cur.h < 0);
+        const double am = firstFlips ? m1 : m2;
+        const Eval em = firstFlips ? e1 : e2;
+        if (!em.ok || (em.h < 0) == (cur.h < 0)) continue;
+        refine(angle(k - 1), am, prev.h, em.h);
+        refine(am, angle(k + 1), em.h, grid[k + 1].h);
     }
     return n;
 }
@@ -311,7 +369,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                 if (!scene.pointLightCaustics || !lights.pointLights) continue;
                 // Every root to the light's one point y: f I T (1 - F1)(1 - F2) / G.
                 const Vec3 y = light.desc().position;
-                const int n = connectThroughSphere(s, v.p, y, roots);
+                const int n = connectThroughSphere(s, v.p, y, roots, true);
                 for (int k = 0; k < n; ++k) {
                     const SphereConnection& cn = roots[k];
                     if (!(cn.spreading > 0)) continue;

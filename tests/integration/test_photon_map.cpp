@@ -14,6 +14,8 @@
 #include "estimators/estimator.h"
 #include "photons/photon_map.h"
 #include "photons/photon_tracer.h"
+#include "illumination/illumination.h"
+#include "transport/sphere_caustics.h"
 #include "support/support.h"
 
 namespace vdbmarch {
@@ -139,8 +141,8 @@ TEST(PhotonMapAccuracy, ForwardScatteringMatchesClosedFormAndReference) { checkA
 TEST(PhotonTracing, DeterministicForAnyThreadCount) {
     auto scene = sceneFromJson(boxScene(0.5f, 4));
     PhotonSet one, two;
-    tbb::task_arena(1).execute([&] { one = tracePhotons(*scene, 20000, 5); });
-    tbb::task_arena(2).execute([&] { two = tracePhotons(*scene, 20000, 5); });
+    tbb::task_arena(1).execute([&] { one = tracePhotons(*scene, 100000, 5); });
+    tbb::task_arena(2).execute([&] { two = tracePhotons(*scene, 100000, 5); });
     ASSERT_GT(one.photons.size(), 10000u);
     ASSERT_EQ(one.photons.size(), two.photons.size());
     EXPECT_EQ(0, std::memcmp(one.photons.data(), two.photons.data(), one.photons.size() * sizeof(Photon)));
@@ -193,6 +195,48 @@ TEST(PhotonStorage, CompactDirectionAndPhase) {
         EXPECT_TRUE(p.isFromPointLight());
         EXPECT_NEAR(p.g(), g, 1.f / 32767);
     }
+}
+
+}  // namespace
+}  // namespace vdbmarch
+
+namespace vdbmarch {
+namespace {
+
+// Photon::Connected marks the caustic photons whose light sphere caustic
+// connections compute at the photon's position: each must be a caustic of
+// the point light that came straight out of the ball from it. The
+// marchers' map (render.li = "path") then leaves them out, and only those.
+TEST(PhotonTracing, ConnectedPhotonsAreTheCausticsTheConnectionsFind) {
+    auto scene = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {}));
+    ASSERT_TRUE(scene->pointLightCaustics);
+    const PhotonSet set = tracePhotons(*scene, 100000, 5);
+    const GlassSphere& ball = scene->glassSpheres.at(0);
+    const Vec3 light = scene->lights.at(0).desc().position;
+    size_t connected = 0, caustic = 0;
+    for (const Photon& p : set.photons) {
+        caustic += p.isCaustic();
+        if (!p.isConnected()) continue;
+        ++connected;
+        EXPECT_TRUE(p.isCaustic() && p.isFromPointLight() && !p.isDirect());
+        // Back along its travel through the ball, the photon's path must
+        // leave towards the light (within the 32-bit direction's precision).
+        SphereConnection tr;
+        ASSERT_TRUE(traceThroughSphere(ball, p.position, -p.travelDirection(), tr));
+        const Vec3 v = light - tr.p2;
+        EXPECT_GT(dot(v, tr.wo), 0.f);
+        EXPECT_LT(length(v - tr.wo * dot(v, tr.wo)), 1e-3f * length(v))
+            << "photon at " << p.position.x << " " << p.position.y << " " << p.position.z;
+    }
+    EXPECT_GT(connected, 100u);
+    EXPECT_LT(connected, caustic);  // reflections off the ball and later bounces stay caustic only
+
+    const IlluminationRequest rq = illuminationRequest(*scene, Method::Guided);
+    EXPECT_TRUE(rq.exceptConnected);
+    const auto off = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {"render.sphere_caustics=false"}));
+    EXPECT_FALSE(off->pointLightCaustics);
+    EXPECT_FALSE(illuminationRequest(*off, Method::Guided).exceptConnected);
+    for (const Photon& p : tracePhotons(*off, 20000, 5).photons) EXPECT_FALSE(p.isConnected());
 }
 
 }  // namespace

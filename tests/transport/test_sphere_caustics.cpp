@@ -56,6 +56,38 @@ TEST(SphereCaustics, EveryConnectionPassesThroughItsEndPoint) {
     EXPECT_GT(multiple, 0);  // inside the caustic's envelope three paths meet
 }
 
+// The paths of a point light through the ball, traced forwards from the
+// light, then found again from points along their exit rays: near the
+// lens's axis, where the rays through its middle cross in pairs closer than
+// the solver's grid, and near the folds of the caustic.
+TEST(SphereCaustics, TheSolverFindsEveryTracedPathFromAPoint) {
+    const GlassSphere s = ball();
+    const Vec3 y(0.f, 2.6f, 0.f);
+    Rng rng(3);
+    int tried = 0, missed = 0;
+    for (int i = 0; i < 20000; ++i) {
+        // A direction from y into the ball's cone, traced through it.
+        const Vec3 axis = normalize(s.center - y);
+        const float sin2 = s.radius * s.radius / lengthSquared(s.center - y);
+        const Vec3 w = sampleUniformCone(axis, std::sqrt(1 - sin2), rng.uniform(), rng.uniform());
+        SphereConnection t;
+        if (!traceThroughSphere(s, y, w, t)) continue;
+        // A point on the exit ray, up to 2.5 below the ball.
+        const Vec3 x = t.p2 + t.wo * (0.05f + 2.5f * rng.uniform());
+        ++tried;
+        SphereConnection c[MaxSphereConnections];
+        const int n = connectThroughSphere(s, x, y, c, true);
+        float best = -1;
+        for (int k = 0; k < n; ++k) best = std::max(best, dot(c[k].wi, -t.wo));
+        missed += !(best > 0.99999f);
+        if (!(best > 0.99999f) && missed <= 4)
+            ADD_FAILURE() << "no root for the path through x = " << x.x << " " << x.y << " " << x.z << " (" << n
+                          << " found)";
+    }
+    EXPECT_GT(tried, 15000);
+    EXPECT_EQ(missed, 0) << "of " << tried;
+}
+
 // Irradiance-like integral at x of the light through the ball: the
 // integral over directions w of L_e [the ray through the ball hits the light]
 // (1 - F1)(1 - F2) (an isotropic receiver, f = 1).
