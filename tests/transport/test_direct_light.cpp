@@ -91,7 +91,9 @@ TEST(PhaseRoulette, KeepsTheMeanOfNextEventEstimation) {
         ++k;
         raysOn += on.shadowRays;
         raysOff += off.shadowRays;
-        if (k <= 2) EXPECT_EQ(on.shadowRays, off.shadowRays) << "inside the lobe every shadow ray is cast";
+        if (k <= 2) {
+            EXPECT_EQ(on.shadowRays, off.shadowRays) << "inside the lobe every shadow ray is cast";
+        }
         const double se = std::sqrt(off.variance + on.variance);
         EXPECT_LE(std::fabs(on.mean - off.mean), 4 * se + 1e-12)
             << "vertex " << k << ": with roulette " << on.mean << ", without " << off.mean << ", se " << se;
