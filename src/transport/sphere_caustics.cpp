@@ -243,8 +243,8 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
             continue;
         }
         // Two roots closer than the grid's step leave no sign change: near
-        // the lens's axis, where the rays through its middle cross, they lie
-        // on either side of an extremum of h. Where |h| has a local minimum
+        // a fold of the caustic, where two paths from x merge, they lie on
+        // either side of an extremum of h. Where |h| has a local minimum
         // at a grid point with the same sign on both sides, find the
         // extremum (golden section) and, if h changes sign there, both roots.
         if (!thorough || k + 1 >= N || !grid[k + 1].ok || (grid[k + 1].h < 0) != (cur.h < 0)) continue;
@@ -254,9 +254,9 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
         const double g = 0.5 * (std::sqrt(5.0) - 1);
         double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
         Eval e1 = eval(m1), e2 = eval(m2);
-        // To a thousandth of the step: a pair closer than that carries a
-        // vanishing share of the light (G -> 0 where two roots merge only
-        // as the square root of the distance to the fold).
+        // To a thousandth of the step: a pair closer than that lies within
+        // about (1e-3 step)^2 of a fold (their gap grows as the square root
+        // of the distance), a vanishing share of the light.
         for (int i = 0; i < RootIterations && e1.ok && e2.ok && hi - lo > 1e-3 * step; ++i) {
             if (sign * e1.h < sign * e2.h) {
                 hi = m2;
