@@ -83,6 +83,12 @@ void findGlassSpheres(Scene& scene) {
     }
 }
 
+bool hasRefractingGlass(const Scene& scene) {
+    for (const SurfaceInfo& info : scene.surfaces)
+        if (info.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(info.material)) return true;
+    return false;
+}
+
 // Scene::pointLightCaustics.
 bool connectsPointLightCaustics(const Scene& scene) {
     if (!scene.desc.render.sphereCaustics) return false;
@@ -276,6 +282,21 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     computeShadowReach(*scene);
     findGlassSpheres(*scene);
     scene->pointLightCaustics = connectsPointLightCaustics(*scene);
+    // Delta lights behind refracting glass with nothing inside it: the path
+    // tracer finds their caustics only where the sphere connections do.
+    if (isPathTracer(desc.render.method) && !scene->pointLightCaustics) {
+        bool deltaLight = false, glassWithMedium = false;
+        for (const Light& l : scene->lights) deltaLight = deltaLight || l.isDelta();
+        for (const auto& s : desc.surfaces)
+            glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric &&
+                                                  s.material.ior != 1.f && !s.interior.empty());
+        if (deltaLight && !glassWithMedium && hasRefractingGlass(*scene))
+            warn(str(desc.file, ": the caustics of a delta light (point, spot, directional or collimated_quad) "
+                                "through refracting glass are missing from a unidirectional path tracer, except "
+                                "those of point and spot lights through glass spheres with render.sphere_caustics "
+                                "(docs/method.md, \"Caustics through glass spheres\"); use sphere lights where the "
+                                "reference must converge"));
+    }
     return scene;
 }
 

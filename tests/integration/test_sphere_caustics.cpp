@@ -172,6 +172,20 @@ TEST(SphereCausticRenders, GuidedMarcherConnectsToPointLightsLikeThePathTracer) 
                           renderWith("scenes/fig4_caustic.json", guided, true), "guided, a sphere light");
 }
 
+TEST(SphereCaustics, ThePathTracerWarnsWhereItMissesCaustics) {
+    auto warnings = [](const std::vector<std::string>& extra) {
+        std::vector<std::string> o = {"render.method=\"reference\""};
+        o.insert(o.end(), extra.begin(), extra.end());
+        const int before = warningCount();
+        buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), o));
+        return warningCount() - before;
+    };
+    EXPECT_EQ(warnings({}), 0);  // the point light's caustics are connected
+    EXPECT_EQ(warnings({"render.sphere_caustics=false"}), 1);
+    EXPECT_NE(lastWarning().find("render.sphere_caustics"), std::string::npos) << lastWarning();
+    EXPECT_EQ(warnings({R"(surfaces.0.transform={"scale": [0.45, 0.3, 0.45], "translate": [0, 0.75, 0]})"}), 1);
+}
+
 TEST(SphereCaustics, PointLightCausticsOnlyWhereConnectionsFindThemAll) {
     auto flag = [](const std::vector<std::string>& o) {
         return buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), o))->pointLightCaustics;
