@@ -89,6 +89,30 @@ bool hasRefractingGlass(const Scene& scene) {
     return false;
 }
 
+// A path tracer cannot reach a delta light through refracting glass, except
+// point and spot lights through glass spheres (Scene::pointLightCaustics):
+// a render by one says what it misses.
+void warnOfMissedCaustics(const Scene& scene) {
+    const SceneDesc& desc = scene.desc;
+    if (!isPathTracer(desc.render.method) || scene.pointLightCaustics) return;
+    bool deltaLight = false, glassWithMedium = false;
+    for (const Light& l : scene.lights) deltaLight = deltaLight || l.isDelta();
+    for (const auto& s : desc.surfaces)
+        glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric &&
+                                              s.material.ior != 1.f && !s.interior.empty());
+    if (!deltaLight) return;
+    if (glassWithMedium)
+        warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
+                            "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
+                            "light in the reference; use sphere lights where the reference must converge"));
+    else if (hasRefractingGlass(scene))
+        warn(str(desc.file, ": the caustics of a delta light (point, spot, directional or collimated_quad) "
+                            "through refracting glass are missing from a unidirectional path tracer, except "
+                            "those of point and spot lights through glass spheres with render.sphere_caustics "
+                            "(docs/method.md, \"Caustics through glass spheres\"); use sphere lights where the "
+                            "reference must converge"));
+}
+
 // Scene::pointLightCaustics.
 bool connectsPointLightCaustics(const Scene& scene) {
     if (!scene.desc.render.sphereCaustics) return false;
@@ -208,17 +232,6 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
                               !scene->media[size_t(mi)]->hasEmission;
         }
     }
-    if (isPathTracer(desc.render.method)) {
-        bool deltaLight = false, glassWithMedium = false;
-        for (const auto& l : desc.lights) deltaLight = deltaLight || l.type != LightDesc::Type::Sphere;
-        for (const auto& s : desc.surfaces)
-            glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric &&
-                                                  s.material.ior != 1.f && !s.interior.empty());
-        if (deltaLight && glassWithMedium)
-            warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
-                                "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
-                                "light in the reference; use sphere lights where the reference must converge"));
-    }
 
     // Surfaces.
     scene->surfaceSet = std::make_unique<SurfaceSet>();
@@ -282,21 +295,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     computeShadowReach(*scene);
     findGlassSpheres(*scene);
     scene->pointLightCaustics = connectsPointLightCaustics(*scene);
-    // Delta lights behind refracting glass with nothing inside it: the path
-    // tracer finds their caustics only where the sphere connections do.
-    if (isPathTracer(desc.render.method) && !scene->pointLightCaustics) {
-        bool deltaLight = false, glassWithMedium = false;
-        for (const Light& l : scene->lights) deltaLight = deltaLight || l.isDelta();
-        for (const auto& s : desc.surfaces)
-            glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric &&
-                                                  s.material.ior != 1.f && !s.interior.empty());
-        if (deltaLight && !glassWithMedium && hasRefractingGlass(*scene))
-            warn(str(desc.file, ": the caustics of a delta light (point, spot, directional or collimated_quad) "
-                                "through refracting glass are missing from a unidirectional path tracer, except "
-                                "those of point and spot lights through glass spheres with render.sphere_caustics "
-                                "(docs/method.md, \"Caustics through glass spheres\"); use sphere lights where the "
-                                "reference must converge"));
-    }
+    warnOfMissedCaustics(*scene);
     return scene;
 }
 
