@@ -13,6 +13,7 @@
 #include "transport/media_point.h"
 #include "transport/path_tracer.h"
 #include "transport/roulette.h"
+#include "transport/sphere_caustics.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
 
@@ -153,12 +154,7 @@ private:
                 // scattering vertex, through straight shadow rays.
                 if (direct && src.deltaLight && e.kind != SurfaceEvent::Kind::Diffuse) caustic = true;
                 direct = false;
-                const int sphere = e.kind == SurfaceEvent::Kind::Refract ? glassSphereOf(scene, h.surface) : -1;
-                if (sphere < 0 || (lensSphere >= 0 && sphere != lensSphere)) lensRefractions = -1;
-                else if (lensRefractions >= 0) {
-                    lensSphere = sphere;
-                    ++lensRefractions;
-                }
+                followLensPattern(scene, e.kind == SurfaceEvent::Kind::Refract, h.surface, lensSphere, lensRefractions);
             }
             if (!russianRoulette(beta, rng, ScatterRouletteThreshold)) return;
             ray = e.ray;

@@ -17,6 +17,12 @@ int glassSphereOf(const Scene& scene, int surface) {
     return -1;
 }
 
+bool hasBendingGlass(const Scene& scene) {
+    for (const SurfaceInfo& s : scene.surfaces)
+        if (s.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(s.material)) return true;
+    return false;
+}
+
 int regionAtRayStart(const Scene& scene, const Ray& r) {
     SurfaceHit h;
     if (!scene.surfaceSet->intersect(r, 0.f, Infinity, h)) return Scene::WorldRegion;
@@ -83,12 +89,6 @@ void findGlassSpheres(Scene& scene) {
     }
 }
 
-bool hasRefractingGlass(const Scene& scene) {
-    for (const SurfaceInfo& info : scene.surfaces)
-        if (info.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(info.material)) return true;
-    return false;
-}
-
 // A path tracer cannot reach a delta light through refracting glass, except
 // point and spot lights through glass spheres (Scene::pointLightCaustics):
 // a render by one says what it misses.
@@ -105,7 +105,7 @@ void warnOfMissedCaustics(const Scene& scene) {
         warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
                             "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
                             "light in the reference; use sphere lights where the reference must converge"));
-    else if (hasRefractingGlass(scene))
+    else if (hasBendingGlass(scene))
         warn(str(desc.file, ": the caustics of a delta light (point, spot, directional or collimated_quad) "
                             "through refracting glass are missing from a unidirectional path tracer, except "
                             "those of point and spot lights through glass spheres with render.sphere_caustics "
@@ -118,10 +118,8 @@ bool connectsPointLightCaustics(const Scene& scene) {
     if (!scene.desc.render.sphereCaustics) return false;
     for (size_t i = 0; i < scene.surfaces.size(); ++i) {
         const SurfaceInfo& info = scene.surfaces[i];
-        if (info.material.type != MaterialDesc::Type::Dielectric || crossedByShadowRays(info.material)) continue;
-        bool sphere = false;
-        for (const GlassSphere& g : scene.glassSpheres) sphere = sphere || g.surface == int(i);
-        if (!sphere) return false;
+        const bool bends = info.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(info.material);
+        if (bends && glassSphereOf(scene, int(i)) < 0) return false;
     }
     bool pointLike = false;
     for (const Light& l : scene.lights) {

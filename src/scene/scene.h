@@ -51,6 +51,9 @@ bool crossedByShadowRays(const MaterialDesc& material);
 class Scene;
 // The index in Scene::glassSpheres of surface `surface`'s glass sphere, or -1.
 int glassSphereOf(const Scene& scene, int surface);
+// True when some surface refracts or reflects (a dielectric with ior != 1):
+// light that passes it cannot be followed by shadow rays.
+bool hasBendingGlass(const Scene& scene);
 
 class Scene {
 public:

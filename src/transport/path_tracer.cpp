@@ -309,12 +309,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             st.specular = true;  // next-event estimation cannot see through this
             // Two refractions through one glass sphere keep the pattern of
             // a sphere caustic connection; anything else breaks it.
-            const int sphere = e.kind == SurfaceEvent::Kind::Refract ? glassSphereOf(scene, h.surface) : -1;
-            if (sphere < 0 || (st.lensSphere >= 0 && st.lensSphere != sphere)) st.lensRefractions = -1;
-            else if (st.lensRefractions >= 0) {
-                st.lensSphere = sphere;
-                ++st.lensRefractions;
-            }
+            followLensPattern(scene, e.kind == SurfaceEvent::Kind::Refract, h.surface, st.lensSphere,
+                              st.lensRefractions);
         }
         beta *= weight;
         ray = next;

@@ -98,6 +98,20 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
 float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const Vec3& x, const Vec3& w, float pathPdf,
                               const Vec3& y);
 
+// The pattern of a sphere caustic connection along a light path: refractions
+// into and out of one glass sphere and nothing else. After each bending
+// surface event (a refraction or reflection at `surface`), `refractions`
+// counts the refractions at sphere `sphere`, or is -1 once anything else
+// broke the pattern (it stays -1).
+inline void followLensPattern(const Scene& scene, bool refraction, int surface, int& sphere, int& refractions) {
+    const int s = refraction ? glassSphereOf(scene, surface) : -1;
+    if (s < 0 || (sphere >= 0 && sphere != s)) refractions = -1;
+    else if (refractions >= 0) {
+        sphere = s;
+        ++refractions;
+    }
+}
+
 // True when sphere caustic connections apply at a vertex in `region`
 // (render.sphere_caustics, a sphere light or Scene::pointLightCaustics, a
 // glass sphere around the region).

@@ -36,12 +36,6 @@ RaySegment nextRaySegment(const Scene& scene, const Ray& r, float tMax) {
     return seg;
 }
 
-bool hasBendingGlass(const Scene& scene) {
-    for (const SurfaceInfo& s : scene.surfaces)
-        if (s.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(s.material)) return true;
-    return false;
-}
-
 SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& h, const Vec3& d, int region, const float u[3],
                                 TransportMode mode) {
     const SurfaceInfo& s = scene.surfaces[size_t(h.surface)];

@@ -31,9 +31,6 @@ struct SurfaceEvent {
 SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& hit, const Vec3& d, int region, const float u[3],
                                 TransportMode mode);
 
-// True when some surface refracts or reflects (a dielectric with ior != 1):
-// light that passes it cannot be followed by shadow rays.
-bool hasBendingGlass(const Scene& scene);
 
 // Offset origin for a ray leaving a surface at p in direction d.
 Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d);
