@@ -81,7 +81,7 @@ PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext
             // Light through glass spheres (sphere_caustics.h): point and spot
             // lights, which no path finds; sphere lights too where max_depth
             // ends the path here, else the path below finds them.
-            if (regionHasSphereCaustics(scene, region)) {
+            if (sceneHasSphereCaustics(scene)) {
                 const bool last = diffuseBounces + 1 >= scene.desc.render.maxDepth;
                 Ld += beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching,
                                                 {last, true, !last});
@@ -178,7 +178,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     // continuation's own hits, and point and spot lights, whose photons
     // then leave these caustics out (transport/sphere_caustics.h,
     // Photon::Connected).
-    const bool caustics = regionHasSphereCaustics(mScene, region);
+    const bool caustics = sceneHasSphereCaustics(mScene);
     if (caustics) {
         const Color Lc = sphereCausticLight(ctx, region, nextEventVertex, rng, TransmittanceEstimator::UnbiasedMarching);
         Li += Lc;

@@ -50,8 +50,8 @@ struct Photon {
                        // no path with next-event estimation finds this light
         FromPointLight = 4u,  // emitted by a point or spot light
         // A caustic that sphere caustic connections find (Scene::pointLightCaustics):
-        // from a point or spot light through exactly one glass sphere, in and
-        // out, with no other event before it landed.
+        // from a point or spot light through one glass sphere (in and out),
+        // or across its surface once, with no other event before it landed.
         Connected = 8u,
     };
     Vec3 position;

@@ -92,8 +92,9 @@ private:
         int depth = 0, surfaceBounces = 0;
         bool caustic = false;  // bent before its first scattering event, from a delta light
         // The events since emission while nothing scattered the photon:
-        // refractions into and out of one glass sphere (Photon::Connected
-        // after exactly two), -1 once anything else happened.
+        // refractions at one glass sphere (Photon::Connected after one,
+        // across its surface, or two, through it), -1 once anything else
+        // happened.
         int lensSphere = -1, lensRefractions = mScene.pointLightCaustics && src.pointLight ? 0 : -1;
         Color beta(1);  // throughput relative to the emitted power
         MediumPoint mp;
@@ -120,7 +121,7 @@ private:
                 mp.phase.legendreWeights(1, w);
                 ph.flags = Photon::packFlags((direct ? Photon::Direct : 0u) | (caustic ? Photon::Caustic : 0u) |
                                                  (src.pointLight ? Photon::FromPointLight : 0u) |
-                                                 (lensRefractions == 2 ? Photon::Connected : 0u),
+                                                 (lensRefractions >= 1 ? Photon::Connected : 0u),
                                              w[1]);
                 out.push_back(ph);
                 if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {

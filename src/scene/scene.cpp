@@ -56,14 +56,15 @@ bool mayBeInside(const Scene& scene, const Vec3& p, const std::vector<int>& arou
     return false;
 }
 
-// The spheres of refracting glass, uniformly scaled and empty inside, that
-// next-event estimation sees light through (transport/sphere_caustics.h).
+// The spheres of refracting glass, uniformly scaled, that next-event
+// estimation sees light through (transport/sphere_caustics.h), empty or
+// holding a medium.
 void findGlassSpheres(Scene& scene) {
     for (size_t i = 0; i < scene.desc.surfaces.size(); ++i) {
         const SurfaceDesc& sd = scene.desc.surfaces[i];
         const SurfaceInfo& info = scene.surfaces[i];
         if (sd.shape != SurfaceDesc::Shape::Sphere || info.material.type != MaterialDesc::Type::Dielectric ||
-            crossedByShadowRays(info.material) || !scene.regions[size_t(info.interiorRegion)].media.empty())
+            crossedByShadowRays(info.material))
             continue;
         // Uniform scale: three orthogonal columns of one length.
         const Mat4& m = sd.transform;
@@ -83,6 +84,7 @@ void findGlassSpheres(Scene& scene) {
         g.ior = info.material.ior;
         g.surface = int(i);
         g.outside = info.exteriorRegion;
+        g.inside = info.interiorRegion;
         for (size_t j = 0; j < scene.surfaces.size(); ++j)
             if (j != i && scene.surfaceSet->mayComeWithin(int(j), g.center, g.radius)) g.clearInside = false;
         scene.glassSpheres.push_back(g);
@@ -104,7 +106,8 @@ void warnOfMissedCaustics(const Scene& scene) {
     if (glassWithMedium)
         warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
                             "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
-                            "light in the reference; use sphere lights where the reference must converge"));
+                            "light in the reference, except from point and spot lights through glass spheres with "
+                            "render.sphere_caustics; use sphere lights where the reference must converge"));
     else if (hasBendingGlass(scene))
         warn(str(desc.file, ": the caustics of a delta light (point, spot, directional or collimated_quad) "
                             "through refracting glass are missing from a unidirectional path tracer, except "
@@ -126,8 +129,10 @@ bool connectsPointLightCaustics(const Scene& scene) {
         if (!l.isDelta()) continue;
         if (!l.isPointLike()) return false;
         pointLike = true;
+        // Inside a sphere or outside all, off their surfaces (where the
+        // connections' roots would not be found).
         for (const GlassSphere& g : scene.glassSpheres)
-            if (!(length(l.desc().position - g.center) > g.radius)) return false;
+            if (!(std::fabs(length(l.desc().position - g.center) - g.radius) > 1e-4f * g.radius)) return false;
     }
     return pointLike;
 }

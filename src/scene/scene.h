@@ -41,6 +41,7 @@ struct GlassSphere {
     float ior = 1.5f;
     int surface = -1;
     int outside = 0;          // the region around it
+    int inside = 0;           // the region it holds (its medium, if any)
     bool clearInside = true;  // no other surface comes inside it
 };
 
@@ -76,7 +77,8 @@ public:
     // glass are found by sphere caustic connections (sphere_caustics.h), so
     // no photon needs to carry them: render.sphere_caustics, every
     // refracting surface one of glassSpheres, at least one point or spot
-    // light and every delta light a point or spot outside all the spheres.
+    // light and every delta light a point or spot off the spheres' surfaces
+    // (inside one or outside all).
     bool pointLightCaustics = false;
 
     // Whether a shadow ray that starts in `region` can ever reach light

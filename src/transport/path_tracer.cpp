@@ -108,7 +108,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     // those were made (the path's own hits through a ball weigh against them).
     auto nextEvent = [&](const ScatterVertex& vertex, const float* lightWeights) {
         add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, lightWeights)), st.depth);
-        if (!regionHasSphereCaustics(scene, region)) return false;
+        if (!sceneHasSphereCaustics(scene)) return false;
         add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching,
                                               {true, !st.pointLightsByPhotons, true}),
             st.depth);
@@ -264,11 +264,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 float d2 = lengthSquared(to), r2 = l.desc().radius * l.desc().radius;
                 float sin2 = r2 / d2, cosMax = sin2 < 1e-6f ? 1 - 0.5f * sin2 : safeSqrt(1 - sin2);
                 w = powerHeuristic(st.lastPdf, uniformConePdf(cosMax));
-            } else if (st.causticsAtLast && st.lensRefractions == 2) {
-                // Through a glass sphere, which sphere caustic connections
-                // at lastPoint also follow.
-                w = sphereCausticPathWeight(scene, st.lensSphere, light, st.lastPoint, st.lastDir, st.lastPdf,
-                                            ray.at(tEnd));
+            } else if (st.causticsAtLast && st.lensRefractions >= 1) {
+                // Through a glass sphere (or across its surface), which
+                // sphere caustic connections at lastPoint also follow.
+                w = sphereCausticPathWeight(scene, st.lensSphere, st.lensRefractions, light, st.lastPoint, st.lastDir,
+                                            st.lastPdf, ray.at(tEnd));
             }
             add(beta * l.emittedRadiance() * w, st.depth);
             return result(0.f);
@@ -307,8 +307,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             startVertex(st, h.p, next.d, pdf, caustics);
         } else if (!e.straight) {
             st.specular = true;  // next-event estimation cannot see through this
-            // Two refractions through one glass sphere keep the pattern of
-            // a sphere caustic connection; anything else breaks it.
+            // Refractions at one glass sphere keep the pattern of a sphere
+            // caustic connection; anything else breaks it.
             followLensPattern(scene, e.kind == SurfaceEvent::Kind::Refract, h.surface, st.lensSphere,
                               st.lensRefractions);
         }

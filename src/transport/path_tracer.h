@@ -55,9 +55,9 @@ struct PathState {
     // paths before their next segment found that light.
     float rouletteScale = 1;
     // Sphere caustic connections (sphere_caustics.h) were made at lastPoint,
-    // and the refractions since then through one glass sphere: a sphere
-    // light hit after exactly two (in and out) takes the MIS weight against
-    // them. -1 in lensSphere: none yet; lensRefractions < 0: another event
+    // and the refractions since then at one glass sphere: a sphere light
+    // hit after one (across its surface) or two (in and out) takes the MIS
+    // weight against them. -1 in lensSphere: none yet; lensRefractions < 0: another event
     // broke the pattern.
     bool causticsAtLast = false;
     Vec3 lastDir{0, 0, 1};  // the direction sampled at lastPoint

@@ -70,6 +70,27 @@ bool trace(const GlassSphere& s, const D3& x, const D3& w, Traced& out) {
     return true;
 }
 
+// The ray x + t w across the surface of sphere s once: into it from
+// outside, or out of it from inside.
+bool traceAcross(const GlassSphere& s, const D3& x, const D3& w, Traced& out) {
+    const D3 c(s.center);
+    const double R = s.radius;
+    const D3 oc = x - c;
+    const double b = dot(w, oc), cc = dot(oc, oc) - R * R;
+    const double disc = b * b - cc;
+    if (!(disc > 0)) return false;
+    const bool entering = cc > 0;
+    if (entering && !(b < 0)) return false;  // the ball behind x
+    const double t = entering ? -b - std::sqrt(disc) : -b + std::sqrt(disc);
+    out.p1 = out.p2 = x + w * t;
+    const D3 n = (out.p1 - c) * (1 / R);  // outwards
+    double F;
+    if (!(entering ? refract(w, n, s.ior, out.wo, F) : refract(w, n * -1.0, 1 / double(s.ior), out.wo, F)))
+        return false;  // total internal reflection
+    out.transmission = 1 - F;
+    return true;
+}
+
 // Bracketing grid (cells) over the outline's arc that x sees, and refinement steps.
 constexpr int RootGrid = 24;
 constexpr int RootGridNearAxis = 4;
@@ -79,8 +100,10 @@ constexpr int RootIterations = 40;
 constexpr double RootMatchCos = 1 - 1e-6;
 
 // G by forward differences from the traced path `base` of w (their error,
-// O(eps) relative, is far below the noise of any estimate).
-double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y, const Traced& base) {
+// O(eps) relative, is far below the noise of any estimate); `trace` is the
+// pattern's tracer (trace or traceAcross).
+template <class Trace>
+double spreading(Trace&& trace, const GlassSphere& s, const D3& x, const D3& w, const D3& y, const Traced& base) {
     // The exit ray of w perturbed by (u, v) in a tangent frame, met with the
     // plane through y perpendicular to the exit direction.
     const D3 helper = std::fabs(w.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0);
@@ -98,7 +121,7 @@ double spreading(const GlassSphere& s, const D3& x, const D3& w, const D3& y, co
     return length(cross(q[0] - q0, q[1] - q0)) / (eps * eps);
 }
 
-SphereConnection toConnection(const D3& w, const Traced& tr, double G) {
+SphereConnection toConnection(const D3& w, const Traced& tr, double G, int refractions) {
     SphereConnection c;
     c.wi = w.f();
     c.p1 = tr.p1.f();
@@ -106,12 +129,153 @@ SphereConnection toConnection(const D3& w, const Traced& tr, double G) {
     c.wo = tr.wo.f();
     c.transmission = float(tr.transmission);
     c.spreading = G;
+    c.refractions = refractions;
     return c;
 }
 
-// The glass sphere a sphere light can be reached through: outside it.
+// The glass sphere a sphere light can be reached through: outside it, or
+// (one refraction) inside it.
 bool lightOutside(const GlassSphere& s, const Light& l) {
     return l.isSphere() && length(l.desc().position - s.center) > s.radius + l.desc().radius;
+}
+bool lightInside(const GlassSphere& s, const Light& l) {
+    return l.isSphere() && length(l.desc().position - s.center) + l.desc().radius < s.radius;
+}
+
+// In the plane of the ball's outline (centre at the origin, radius R), the
+// ray from (dx, 0) to the outline point R (ca, sa), refracted into the
+// ball: its incident and transmitted cosines and its direction inside.
+// False where the point is on the outline's far side.
+struct PlaneEntry {
+    double cosI, cosT, d1x, d1y;
+};
+inline bool enterInPlane(double R, double dx, double eta, double ca, double sa, PlaneEntry& e) {
+    const double px = R * ca - dx, py = R * sa;
+    const double inv = 1 / std::sqrt(px * px + py * py);
+    const double d0x = px * inv, d0y = py * inv;
+    e.cosI = -(d0x * ca + d0y * sa);
+    if (!(e.cosI > 0)) return false;
+    const double sin2T = (1 - e.cosI * e.cosI) / (eta * eta);
+    e.cosT = std::sqrt(1 - sin2T);
+    const double k1 = e.cosI / eta - e.cosT;
+    e.d1x = d0x / eta + ca * k1;
+    e.d1y = d0y / eta + sa * k1;
+    return true;
+}
+
+// h on the outline at angle a: which side of the ray after the glass the
+// far end lies (0 on a root), and how far ahead of the ray's start.
+struct ArcEval {
+    bool ok = false;
+    double h = 0, ahead = 0;
+};
+
+// The roots of h over the arc |a| < aMax of the ball's outline, h given as
+// evalCS(cos a, sin a); keep(a, h(a)) takes each. A grid brackets them and
+// false position refines them; a thorough solve also takes the arc's ends,
+// pairs between grid points and a finer grid where `nearAxis`.
+template <class EvalCS, class Keep>
+void solveOnArc(double aMax, bool thorough, bool nearAxis, EvalCS&& evalCS, Keep&& keep) {
+    auto eval = [&](double a) { return evalCS(std::cos(a), std::sin(a)); };
+    // The grid's angles by rotation: one sincos for the whole grid. Its
+    // points are the cells' middles; a thorough solve also takes the arc's
+    // ends, just inside the outline (where the ray grazes the ball and no
+    // refraction is defined), and where x, the centre and y are nearly in
+    // line (within about 6 degrees), where the rays through the lens's
+    // middle cross near its axis and up to three roots share a few degrees
+    // of the arc, cells RootGridNearAxis times finer.
+    const int cells = thorough && nearAxis ? RootGrid * RootGridNearAxis : RootGrid;
+    const int N = thorough ? cells + 1 : cells;
+    const double inset = thorough ? 1e-5 * aMax : 0.0;
+    const double step = (2 * aMax - 2 * inset) / cells, a0 = -aMax + inset + (thorough ? 0.0 : 0.5 * step);
+    const double cStep = std::cos(step), sStep = std::sin(step);
+    ArcEval grid[RootGrid * RootGridNearAxis + 1];
+    double ca = std::cos(a0), sa = std::sin(a0);
+    for (int k = 0; k < N; ++k) {
+        grid[k] = evalCS(ca, sa);
+        const double cNext = ca * cStep - sa * sStep;
+        sa = sa * cStep + ca * sStep;
+        ca = cNext;
+    }
+    auto angle = [&](int k) { return a0 + k * step; };
+    // The root in [lo, hi], where h changes sign, by false position with the
+    // Illinois modification (the bracket stays, convergence is
+    // superlinear).
+    auto refine = [&](double lo, double hi, double hLo, double hHi) {
+        int side = 0;
+        double root = lo;
+        for (int i = 0; i < RootIterations; ++i) {
+            root = (lo * hHi - hi * hLo) / (hHi - hLo);
+            if (!(root > std::min(lo, hi) && root < std::max(lo, hi))) root = 0.5 * (lo + hi);
+            const ArcEval m = eval(root);
+            if (!m.ok) break;
+            if (std::fabs(m.h) < 1e-12 * (1 + std::fabs(m.ahead)) || std::fabs(hi - lo) < 1e-13) break;
+            if ((m.h < 0) == (hLo < 0)) {
+                lo = root;
+                hLo = m.h;
+                if (side == -1) hHi *= 0.5;
+                side = -1;
+            } else {
+                hi = root;
+                hHi = m.h;
+                if (side == 1) hLo *= 0.5;
+                side = 1;
+            }
+        }
+        keep(root, eval(root));
+    };
+    for (int k = 1; k < N; ++k) {
+        const ArcEval &prev = grid[k - 1], &cur = grid[k];
+        if (!prev.ok || !cur.ok) continue;
+        if ((prev.h < 0) != (cur.h < 0)) {
+            refine(angle(k - 1), angle(k), prev.h, cur.h);
+            continue;
+        }
+        // Two roots closer than the grid's step leave no sign change: near
+        // a fold of the caustic, where two paths from x merge, they lie on
+        // either side of an extremum of h. Where |h| has a local minimum
+        // at a grid point with the same sign on both sides, find the
+        // extremum (golden section) and, if h changes sign there, both roots.
+        if (!thorough || k + 1 >= N || !grid[k + 1].ok || (grid[k + 1].h < 0) != (cur.h < 0)) continue;
+        if (!(std::fabs(cur.h) <= std::fabs(prev.h) && std::fabs(cur.h) < std::fabs(grid[k + 1].h))) continue;
+        const double sign = cur.h < 0 ? -1 : 1;
+        double lo = angle(k - 1), hi = angle(k + 1);
+        const double g = 0.5 * (std::sqrt(5.0) - 1);
+        double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
+        ArcEval e1 = eval(m1), e2 = eval(m2);
+        // To a thousandth of the step: a pair closer than that lies within
+        // about (1e-3 step)^2 of a fold (their gap grows as the square root
+        // of the distance), a vanishing share of the light.
+        for (int i = 0; i < RootIterations && e1.ok && e2.ok && hi - lo > 1e-3 * step; ++i) {
+            if (sign * e1.h < sign * e2.h) {
+                hi = m2;
+                m2 = m1;
+                e2 = e1;
+                m1 = hi - g * (hi - lo);
+                e1 = eval(m1);
+            } else {
+                lo = m1;
+                m1 = m2;
+                e1 = e2;
+                m2 = lo + g * (hi - lo);
+                e2 = eval(m2);
+            }
+            if ((e1.ok && (e1.h < 0) != (cur.h < 0)) || (e2.ok && (e2.h < 0) != (cur.h < 0))) break;
+        }
+        const bool firstFlips = e1.ok && (e1.h < 0) != (cur.h < 0);
+        const double am = firstFlips ? m1 : m2;
+        const ArcEval em = firstFlips ? e1 : e2;
+        if (!em.ok) continue;
+        if ((em.h < 0) == (cur.h < 0)) {
+            // An extremum that misses y by less than 1e-7 of the distance:
+            // y lies on the fold itself, within rounding of its float
+            // coordinates, where the pair merges into one path.
+            if (std::fabs(em.h) < 1e-7 * em.ahead) keep(am, em);
+            continue;
+        }
+        refine(angle(k - 1), am, prev.h, em.h);
+        refine(am, angle(k + 1), em.h, grid[k + 1].h);
+    }
 }
 
 }  // namespace
@@ -120,7 +284,15 @@ bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, Sphe
     Traced tr;
     const D3 wd = normalize(D3(w));
     if (!trace(s, D3(x), wd, tr)) return false;
-    out = toConnection(wd, tr, 0);
+    out = toConnection(wd, tr, 0, 2);
+    return true;
+}
+
+bool traceAcrossSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out) {
+    Traced tr;
+    const D3 wd = normalize(D3(w));
+    if (!traceAcross(s, D3(x), wd, tr)) return false;
+    out = toConnection(wd, tr, 0, 1);
     return true;
 }
 
@@ -150,21 +322,11 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
     // ahead of the exit point, from the outline point (cos a, sin a) R. The
     // two refractions in closed form: inside, the angle to the normal is
     // theta_t at both ends, so the exit's transmitted cosine is cos theta_i.
-    struct Eval {
-        bool ok = false;
-        double h = 0, ahead = 0;
-    };
     auto evalCS = [&](double ca, double sa) {
-        Eval e;
-        const double px = R * ca - dx, py = R * sa;  // p1 - x
-        const double inv = 1 / std::sqrt(px * px + py * py);
-        const double d0x = px * inv, d0y = py * inv;
-        const double cosI = -(d0x * ca + d0y * sa);
-        if (!(cosI > 0)) return e;
-        const double sin2T = (1 - cosI * cosI) / (eta * eta);
-        const double cosT = std::sqrt(1 - sin2T);
-        const double k1 = cosI / eta - cosT;
-        const double d1x = d0x / eta + ca * k1, d1y = d0y / eta + sa * k1;
+        ArcEval e;
+        PlaneEntry in;
+        if (!enterInPlane(R, dx, eta, ca, sa, in)) return e;
+        const double cosI = in.cosI, cosT = in.cosT, d1x = in.d1x, d1y = in.d1y;
         const double chord = -2 * R * (ca * d1x + sa * d1y);
         if (!(chord > 0)) return e;
         const double p2x = R * ca + d1x * chord, p2y = R * sa + d1y * chord;
@@ -176,54 +338,8 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
         e.ahead = d2x * tx + d2y * ty;
         return e;
     };
-    auto eval = [&](double a) { return evalCS(std::cos(a), std::sin(a)); };
-    // The grid's angles by rotation: one sincos for the whole grid. Its
-    // points are the cells' middles; a thorough solve also takes the arc's
-    // ends, just inside the outline (where the ray grazes the ball and no
-    // refraction is defined), and where x, the centre and y are nearly in
-    // line (within about 6 degrees), where the rays through the lens's
-    // middle cross near its axis and up to three roots share a few degrees
-    // of the arc, cells RootGridNearAxis times finer.
-    const int cells = thorough && yh < 0.1 * length(cy) ? RootGrid * RootGridNearAxis : RootGrid;
-    const int N = thorough ? cells + 1 : cells;
-    const double inset = thorough ? 1e-5 * aMax : 0.0;
-    const double step = (2 * aMax - 2 * inset) / cells, a0 = -aMax + inset + (thorough ? 0.0 : 0.5 * step);
-    const double cStep = std::cos(step), sStep = std::sin(step);
-    Eval grid[RootGrid * RootGridNearAxis + 1];
-    double ca = std::cos(a0), sa = std::sin(a0);
-    for (int k = 0; k < N; ++k) {
-        grid[k] = evalCS(ca, sa);
-        const double cNext = ca * cStep - sa * sStep;
-        sa = sa * cStep + ca * sStep;
-        ca = cNext;
-    }
-    auto angle = [&](int k) { return a0 + k * step; };
     int n = 0;
-    // The root in [lo, hi], where h changes sign, by false position with the
-    // Illinois modification (the bracket stays, convergence is
-    // superlinear); kept if it is a connection.
-    auto refine = [&](double lo, double hi, double hLo, double hHi) {
-        int side = 0;
-        double root = lo;
-        for (int i = 0; i < RootIterations; ++i) {
-            root = (lo * hHi - hi * hLo) / (hHi - hLo);
-            if (!(root > std::min(lo, hi) && root < std::max(lo, hi))) root = 0.5 * (lo + hi);
-            const Eval m = eval(root);
-            if (!m.ok) break;
-            if (std::fabs(m.h) < 1e-12 * (1 + std::fabs(m.ahead)) || std::fabs(hi - lo) < 1e-13) break;
-            if ((m.h < 0) == (hLo < 0)) {
-                lo = root;
-                hLo = m.h;
-                if (side == -1) hHi *= 0.5;
-                side = -1;
-            } else {
-                hi = root;
-                hHi = m.h;
-                if (side == 1) hLo *= 0.5;
-                side = 1;
-            }
-        }
-        const Eval r = eval(root);
+    solveOnArc(aMax, thorough, yh < 0.1 * length(cy), evalCS, [&](double root, const ArcEval& r) {
         // A sign change behind the exit point is no connection.
         Traced tr;
         const D3 w = direction(root);
@@ -231,66 +347,97 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
             std::fabs(r.h) < 1e-6 * length(y - tr.p2)) {
             // 0 where a ray beside it misses the ball (grazing, where the
             // Fresnel transmission vanishes): no usable connection.
-            const double G = spreading(s, x, w, y, tr);
-            if (G > 0 || !thorough) out[n++] = toConnection(w, tr, G);
+            const double G = spreading(trace, s, x, w, y, tr);
+            if (G > 0 || !thorough) out[n++] = toConnection(w, tr, G, 2);
         }
-    };
-    for (int k = 1; k < N; ++k) {
-        const Eval &prev = grid[k - 1], &cur = grid[k];
-        if (!prev.ok || !cur.ok) continue;
-        if ((prev.h < 0) != (cur.h < 0)) {
-            refine(angle(k - 1), angle(k), prev.h, cur.h);
-            continue;
-        }
-        // Two roots closer than the grid's step leave no sign change: near
-        // a fold of the caustic, where two paths from x merge, they lie on
-        // either side of an extremum of h. Where |h| has a local minimum
-        // at a grid point with the same sign on both sides, find the
-        // extremum (golden section) and, if h changes sign there, both roots.
-        if (!thorough || k + 1 >= N || !grid[k + 1].ok || (grid[k + 1].h < 0) != (cur.h < 0)) continue;
-        if (!(std::fabs(cur.h) <= std::fabs(prev.h) && std::fabs(cur.h) < std::fabs(grid[k + 1].h))) continue;
-        const double sign = cur.h < 0 ? -1 : 1;
-        double lo = angle(k - 1), hi = angle(k + 1);
-        const double g = 0.5 * (std::sqrt(5.0) - 1);
-        double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
-        Eval e1 = eval(m1), e2 = eval(m2);
-        // To a thousandth of the step: a pair closer than that lies within
-        // about (1e-3 step)^2 of a fold (their gap grows as the square root
-        // of the distance), a vanishing share of the light.
-        for (int i = 0; i < RootIterations && e1.ok && e2.ok && hi - lo > 1e-3 * step; ++i) {
-            if (sign * e1.h < sign * e2.h) {
-                hi = m2;
-                m2 = m1;
-                e2 = e1;
-                m1 = hi - g * (hi - lo);
-                e1 = eval(m1);
-            } else {
-                lo = m1;
-                m1 = m2;
-                e1 = e2;
-                m2 = lo + g * (hi - lo);
-                e2 = eval(m2);
-            }
-            if ((e1.ok && (e1.h < 0) != (cur.h < 0)) || (e2.ok && (e2.h < 0) != (cur.h < 0))) break;
-        }
-        const bool firstFlips = e1.ok && (e1.h < 0) != (cur.h < 0);
-        const double am = firstFlips ? m1 : m2;
-        const Eval em = firstFlips ? e1 : e2;
-        if (!em.ok || (em.h < 0) == (cur.h < 0)) continue;
-        refine(angle(k - 1), am, prev.h, em.h);
-        refine(am, angle(k + 1), em.h, grid[k + 1].h);
-    }
+    });
     return n;
 }
 
-bool regionHasSphereCaustics(const Scene& scene, int region) {
-    if (!(scene.hasSphereLights || scene.pointLightCaustics) || !scene.desc.render.sphereCaustics) return false;
-    for (const GlassSphere& s : scene.glassSpheres)
-        if (s.outside == region) return true;
-    return false;
+int connectAcrossSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, SphereConnection out[MaxSphereConnections],
+                        bool thorough) {
+    const D3 c(s.center), x(xf), y(yf);
+    const double R = s.radius;
+    // The roots are found from the end outside, o, towards the end inside, i.
+    const double dx = length(x - c), dy = length(y - c);
+    const bool xInside = dx < R;
+    const D3 o = xInside ? y : x, in = xInside ? x : y;
+    const double dO = xInside ? dy : dx, dI = xInside ? dx : dy;
+    if (!(dO > R * (1 + 1e-6)) || !(dI < R * (1 - 1e-6))) return 0;
+    const D3 e1 = (o - c) * (1 / dO);
+    const D3 ci = in - c;
+    const D3 iPerp = ci - e1 * dot(ci, e1);
+    const double ih = length(iPerp);
+    // On the axis through o and the centre, the one path is the axis itself
+    // (any e2 will do); off it, the plane of o, i and the centre.
+    const bool onAxis = !(ih > 1e-9 * R);
+    const D3 e2 = onAxis ? normalize(cross(e1, std::fabs(e1.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0))) : iPerp * (1 / ih);
+    const double aMax = std::acos(R / dO);
+    const double i1 = dot(ci, e1), i2 = onAxis ? 0.0 : ih, eta = s.ior;
+    // h(a): which side of the refracted ray i lies, from the outline point
+    // (cos a, sin a) R, o at (dO, 0).
+    auto evalCS = [&](double ca, double sa) {
+        ArcEval e;
+        PlaneEntry in;
+        if (!enterInPlane(R, dO, eta, ca, sa, in)) return e;
+        const double d1x = in.d1x, d1y = in.d1y;
+        const double tx = i1 - R * ca, ty = i2 - R * sa;
+        e.ok = true;
+        e.h = d1x * ty - d1y * tx;
+        e.ahead = d1x * tx + d1y * ty;
+        return e;
+    };
+    int n = 0;
+    auto keep = [&](double root, const ArcEval& r) {
+        if (!(n < MaxSphereConnections && r.ok && r.ahead > 0)) return;
+        const D3 p = c + (e1 * std::cos(root) + e2 * std::sin(root)) * R;
+        // The path from x: its direction, traced across the surface, must
+        // pass through y.
+        const D3 w = normalize(p - x);
+        Traced tr;
+        if (!traceAcross(s, x, w, tr)) return;
+        const D3 toY = y - tr.p2;
+        if (!(dot(toY, tr.wo) > 0) || !(length(cross(tr.wo, toY)) < 1e-6 * length(toY))) return;
+        const double G = spreading(traceAcross, s, x, w, y, tr);
+        if (G > 0 || !thorough) out[n++] = toConnection(w, tr, G, 1);
+    };
+    if (onAxis) keep(0.0, evalCS(1.0, 0.0));
+    else solveOnArc(aMax, thorough, ih < 0.1 * length(ci), evalCS, keep);
+    return n;
+}
+
+bool sceneHasSphereCaustics(const Scene& scene) {
+    return (scene.hasSphereLights || scene.pointLightCaustics) && scene.desc.render.sphereCaustics &&
+           !scene.glassSpheres.empty();
 }
 
 namespace {
+
+// The pattern a connection from x takes through sphere s to a light: two
+// refractions (in and out) from outside to a light outside, one from
+// outside to a light inside or from inside to a light outside; 0 for none
+// (x and the light on the same side, or a sphere light across the
+// surface). The connections and the paths' weights ask it alike.
+int connectionPattern(const GlassSphere& s, const Light& l, const Vec3& x) {
+    const bool xInside = lengthSquared(x - s.center) < s.radius * s.radius;
+    bool inside, outside;
+    if (l.isPointLike()) {
+        const float d = length(l.desc().position - s.center);
+        inside = d < s.radius;
+        outside = d > s.radius;
+    } else {
+        inside = lightInside(s, l);
+        outside = lightOutside(s, l);
+    }
+    if (xInside) return outside ? 1 : 0;
+    return outside ? 2 : inside ? 1 : 0;
+}
+
+// Every connection of the pattern from x to y.
+int connect(const GlassSphere& s, int pattern, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections],
+            bool thorough = false) {
+    return pattern == 2 ? connectThroughSphere(s, x, y, out, thorough) : connectAcrossSphere(s, x, y, out, thorough);
+}
 
 // The pdf of directions uniform in the cone that sphere s subtends from x
 // (and the cone's cosine). 0 where x is inside, or where the ball is too
@@ -306,12 +453,12 @@ double ballConePdf(const GlassSphere& s, const Vec3& x, float* cosMax = nullptr)
     return 1 / (2 * double(Pi) * oneMinusCos);
 }
 
-// The connections' density over directions at x of the path through s along
-// w that reaches y on light l: 0 when the solver from (x, y) finds no root
-// matching w.
-double connectionPdf(const GlassSphere& s, const Light& l, const Vec3& x, const Vec3& w, const Vec3& y) {
+// The connections' density over directions at x of the path of the pattern
+// along w that reaches y on light l: 0 when the solver from (x, y) finds no
+// root matching w.
+double connectionPdf(const GlassSphere& s, int pattern, const Light& l, const Vec3& x, const Vec3& w, const Vec3& y) {
     SphereConnection roots[MaxSphereConnections];
-    const int n = connectThroughSphere(s, x, y, roots);
+    const int n = connect(s, pattern, x, y, roots);
     int best = -1;
     double bestCos = RootMatchCos;
     for (int k = 0; k < n; ++k) {
@@ -344,36 +491,50 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
     const Vec3 origin = v.shadowOrigin(scene);
     SphereConnection roots[MaxSphereConnections];
     for (const GlassSphere& s : scene.glassSpheres) {
-        if (s.outside != region) continue;
+        const bool xInside = lengthSquared(v.p - s.center) < s.radius * s.radius;
+        const bool mediumInside = !scene.regions[size_t(s.inside)].media.empty();
         float cosMax = 1;
-        const double pc = ballConePdf(s, v.p, &cosMax);
-        // What reaches x from y through the ball along the connection cn:
-        // transmittance x -> p1, nothing inside the ball, p2 -> y.
+        const double pc = xInside ? 0.0 : ballConePdf(s, v.p, &cosMax);
+        // What reaches x from y along the connection cn: transmittance
+        // x -> p1, through the ball's medium (two refractions), p2 -> y.
         auto throughBall = [&](const SphereConnection& cn, const Vec3& y) {
             const float d1 = length(cn.p1 - origin);
             Color T = shadowTransmittance(ctx, region, origin, cn.wi, d1, rng, estimator);
             if (isBlack(T)) return T;
-            if (!s.clearInside) {
-                const Vec3 n1 = normalize(cn.p1 - s.center);
-                const Vec3 d = normalize(cn.p2 - cn.p1);
+            const Vec3 n2 = normalize(cn.p2 - s.center);
+            if (cn.refractions == 1) {
+                // p -> y on the other side (the light's own surface ends the shadow ray).
+                const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
+                return T * shadowTransmittance(ctx, xInside ? s.outside : s.inside, o2, cn.wo, length(y - o2), rng,
+                                               estimator);
+            }
+            const Vec3 n1 = normalize(cn.p1 - s.center);
+            const Vec3 d = normalize(cn.p2 - cn.p1);
+            const Ray inside{offsetRayOrigin(scene, cn.p1, n1, d), d};
+            if (mediumInside) {
+                T *= shadowTransmittance(ctx, s.inside, inside.o, d, length(cn.p2 - inside.o), rng, estimator);
+                if (isBlack(T)) return T;
+            } else if (!s.clearInside) {
                 SurfaceHit h;
-                const Ray inside{offsetRayOrigin(scene, cn.p1, n1, d), d};
                 if (scene.surfaceSet->intersect(inside, 0.f, length(cn.p2 - inside.o) * (1 - 1e-4f), h)) return Color(0);
             }
             // p2 -> y: the light's own surface ends the shadow ray.
-            const Vec3 o2 = offsetRayOrigin(scene, cn.p2, normalize(cn.p2 - s.center), cn.wo);
+            const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
             return T * shadowTransmittance(ctx, s.outside, o2, cn.wo, length(y - o2), rng, estimator);
         };
         for (const Light& light : scene.lights) {
+            const int pattern = connectionPattern(s, light, v.p);
+            if (pattern == 0) continue;
             if (light.isPointLike()) {
                 if (!scene.pointLightCaustics || !lights.pointLights) continue;
                 // Every root to the light's one point y: f I T (1 - F1)(1 - F2) / G.
                 const Vec3 y = light.desc().position;
-                const int n = connectThroughSphere(s, v.p, y, roots, true);
+                const int n = connect(s, pattern, v.p, y, roots, true);
                 for (int k = 0; k < n; ++k) {
                     const SphereConnection& cn = roots[k];
                     if (!(cn.spreading > 0)) continue;
-                    // The intensity towards p2 (a spot's cone and falloff).
+                    // The intensity towards p2, the glass's last point (a
+                    // spot's cone and falloff).
                     LightSample ls;
                     if (!light.sample(cn.p2, 0.f, 0.f, ls)) continue;
                     const Color f = v.f(cn.wi);
@@ -385,14 +546,17 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                 }
                 continue;
             }
-            if (!lights.sphereLights || !lightOutside(s, light)) continue;
+            if (!lights.sphereLights || !light.isSphere()) continue;
             const Vec3 lc = light.desc().position;
             const float rl = light.desc().radius;
             // 1. Connections: y uniform on the light's surface.
             const Vec3 ny = sampleUniformSphere(rng.uniform(), rng.uniform());
             const Vec3 y = lc + ny * rl;
             const double pA = 1 / (4 * double(Pi) * double(rl) * double(rl));
-            const int n = connectThroughSphere(s, v.p, y, roots);
+            const int n = connect(s, pattern, v.p, y, roots);
+            // The cone of directions to the ball is a technique for the
+            // lens pattern only (where the lens focuses the light).
+            const double pcHere = pattern == 2 ? pc : 0.0;
             for (int k = 0; k < n; ++k) {
                 const SphereConnection& cn = roots[k];
                 const double cosY = -double(dot(cn.wo, ny));
@@ -403,12 +567,12 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                 if (isBlack(T)) continue;
                 const double pm = pA * cn.spreading / cosY;  // solid-angle density at x
                 const double pu = lights.pathFollows ? double(v.pdf(cn.wi)) * double(cn.transmission) : 0.0;
-                L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pm, pu, pc) / pm);
+                L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pm, pu, pcHere) / pm);
             }
             // 2. A direction uniform in the ball's cone, traced through it:
             // where the lens focuses the light (G near 0), the light fills
             // much of the ball and this finds it where connections cannot.
-            if (!(pc > 0)) continue;
+            if (!(pcHere > 0)) continue;
             SphereConnection cn;
             const Vec3 axis = normalize(s.center - v.p);
             const Vec3 w = sampleUniformCone(axis, cosMax, rng.uniform(), rng.uniform());
@@ -421,7 +585,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             const Vec3 yHit = cn.p2 + cn.wo * tLight;
             const Color T = throughBall(cn, yHit);
             if (isBlack(T)) continue;
-            const double pm = connectionPdf(s, light, v.p, cn.wi, yHit);
+            const double pm = connectionPdf(s, 2, light, v.p, cn.wi, yHit);
             const double pu = lights.pathFollows ? double(v.pdf(cn.wi)) * double(cn.transmission) : 0.0;
             L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pc, pm, pu) / pc);
         }
@@ -429,16 +593,16 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
     return L;
 }
 
-float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const Vec3& x, const Vec3& w, float pathPdf,
-                              const Vec3& y) {
+float sphereCausticPathWeight(const Scene& scene, int sphere, int refractions, int light, const Vec3& x, const Vec3& w,
+                              float pathPdf, const Vec3& y) {
     const GlassSphere& s = scene.glassSpheres[size_t(sphere)];
     const Light& l = scene.lights[size_t(light)];
-    if (!lightOutside(s, l)) return 1;
+    if (!l.isSphere() || connectionPattern(s, l, x) != refractions) return 1;
     const Vec3 wn = normalize(w);
     SphereConnection traced;
-    if (!traceThroughSphere(s, x, wn, traced)) return 1;
+    if (!(refractions == 2 ? traceThroughSphere(s, x, wn, traced) : traceAcrossSphere(s, x, wn, traced))) return 1;
     const double pu = double(pathPdf) * double(traced.transmission);
-    return float(power3(pu, connectionPdf(s, l, x, wn, y), ballConePdf(s, x)));
+    return float(power3(pu, connectionPdf(s, refractions, l, x, wn, y), refractions == 2 ? ballConePdf(s, x) : 0.0));
 }
 
 }  // namespace vdbmarch

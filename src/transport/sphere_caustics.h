@@ -35,6 +35,14 @@
 // solver and matching their direction to a root, 0 when none matches (the
 // grid missed a pair of roots at a fold), so the weights sum to 1 whatever
 // the solver finds.
+//
+// A light inside the ball seen from outside, or a light outside seen from
+// inside (a lamp in a glass globe; smoke sealed in glass under a spot), is
+// reached across the surface once: x -> p -> y, the same estimates with one
+// Fresnel factor, the roots found on the same arc from the end outside;
+// the connections and the path weigh against each other (no cone). A
+// medium inside the ball attenuates every connection that crosses it
+// (shadow rays through the ball's region).
 #pragma once
 
 #include "core/rng.h"
@@ -50,6 +58,7 @@ struct SphereConnection {
     Vec3 wo;             // unit, from p2 towards y
     float transmission;  // (1 - F1)(1 - F2), the Fresnel transmittances
     double spreading;    // G = dA_perp(y) / d omega(x)
+    int refractions;     // 2: into the ball and out; 1: across its surface (p1 = p2)
 };
 
 // Most connections one (x, y) pair can have through a sphere.
@@ -69,10 +78,23 @@ constexpr int MaxSphereConnections = 8;
 int connectThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections],
                          bool thorough = false);
 
+// Every connection across the surface of sphere s from x to y, one inside
+// it and one outside (one refraction); returns their number. The roots are
+// found on the arc of the outline that the outer end sees; `thorough` as
+// above. On the axis through the outer end and the centre the one path is
+// the axis (a point light at the centre of a glass globe).
+int connectAcrossSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections],
+                        bool thorough = false);
+
 // Traces direction w from x into sphere s and out again (double precision):
 // the exit point and direction, the Fresnel transmittances. False when the
 // ray misses the sphere.
 bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out);
+
+// Traces direction w from x across the surface of sphere s once (into it
+// from outside, out of it from inside). False when the ray misses it or is
+// totally reflected.
+bool traceAcrossSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out);
 
 // Which lights sphereCausticLight connects to, and whether the path goes on
 // from the vertex (its hits of sphere lights through the glass then weigh
@@ -85,18 +107,20 @@ struct CausticLights {
 };
 
 // The caustic light at vertex v (in `region`) through every glass sphere:
-// from sphere lights, the connections to one light point and one direction
-// in the ball's cone, each weighed against the other and the path's own
-// hits; from point and spot lights, the connections to their point.
+// from sphere lights, the connections to one light point (and through the
+// ball, one direction in its cone), each weighed against the other and the
+// path's own hits; from point and spot lights, the connections to their
+// point.
 Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
                          TransmittanceEstimator estimator, const CausticLights& lights = {});
 
 // The power-heuristic weight of a path that left x along w (its direction
-// density pathPdf), refracted into and out of glass sphere `sphere` and hit
-// sphere light `light` at y, against the connections and the cone
-// directions at x (sphereCausticLight).
-float sphereCausticPathWeight(const Scene& scene, int sphere, int light, const Vec3& x, const Vec3& w, float pathPdf,
-                              const Vec3& y);
+// density pathPdf), refracted `refractions` times at glass sphere `sphere`
+// (into and out of it, or across its surface once) and hit sphere light
+// `light` at y, against the connections and the cone directions at x
+// (sphereCausticLight); 1 where those do not take that pattern.
+float sphereCausticPathWeight(const Scene& scene, int sphere, int refractions, int light, const Vec3& x, const Vec3& w,
+                              float pathPdf, const Vec3& y);
 
 // The pattern of a sphere caustic connection along a light path: refractions
 // into and out of one glass sphere and nothing else. After each bending
@@ -112,9 +136,10 @@ inline void followLensPattern(const Scene& scene, bool refraction, int surface, 
     }
 }
 
-// True when sphere caustic connections apply at a vertex in `region`
-// (render.sphere_caustics, a sphere light or Scene::pointLightCaustics, a
-// glass sphere around the region).
-bool regionHasSphereCaustics(const Scene& scene, int region);
+// True when sphere caustic connections apply (render.sphere_caustics, a
+// sphere light or Scene::pointLightCaustics, a glass sphere): every vertex
+// then makes them, through each sphere by where it and the light lie, so a
+// path's weights (sphereCausticPathWeight) know what its last vertex did.
+bool sceneHasSphereCaustics(const Scene& scene);
 
 }  // namespace vdbmarch

@@ -15,11 +15,18 @@
 // tests above check against the paths), a spot whose cone holds the ball
 // must add the point light's caustic, and the guided marcher, which then
 // takes no caustic photons, must agree with the path tracer.
+//
+// A globe of milk (the ball holding a medium): lights inside it reached
+// across its surface once from outside, lights over it reached from the
+// milk across the surface and through the milk from the fog; the same
+// agreements.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "illumination/illumination.h"
+#include "photons/photon_tracer.h"
+#include "transport/sphere_caustics.h"
 #include "support/support.h"
 
 namespace vdbmarch {
@@ -196,8 +203,11 @@ TEST(SphereCaustics, PointLightCausticsOnlyWhereConnectionsFindThemAll) {
     // point light's too.
     EXPECT_FALSE(flag({R"(lights=[{"type": "point", "position": [0, 2.6, 0], "intensity": 1},
                                   {"type": "directional", "direction": [0, -1, 0], "irradiance": 1}])"}));
-    // A light inside the ball, or glass that is not a sphere.
-    EXPECT_FALSE(flag({R"(lights=[{"type": "point", "position": [0, 0.8, 0], "intensity": 1}])"}));
+    // A light inside the ball is connected across its surface; one on the
+    // surface is not (no root of the solver there).
+    EXPECT_TRUE(flag({R"(lights=[{"type": "point", "position": [0, 0.8, 0], "intensity": 1}])"}));
+    EXPECT_FALSE(flag({R"(lights=[{"type": "point", "position": [0, 1.2, 0], "intensity": 1}])"}));
+    // Glass that is not a sphere.
     EXPECT_FALSE(flag({R"(surfaces.0.transform={"scale": [0.45, 0.3, 0.45], "translate": [0, 0.75, 0]})"}));
     // No delta light: nothing to connect (sphere lights connect anyway).
     EXPECT_FALSE(flag({R"(lights=[{"type": "sphere", "position": [0, 2.6, 0], "radius": 0.1, "power": 1}])"}));
@@ -216,6 +226,94 @@ TEST(SphereCausticRenders, SomethingInsideTheBallIsSeenByTheConnections) {
     const Image on = renderWith("scenes/fig4_caustic_sphere.json", o, true);
     const Image off = renderWith("scenes/fig4_caustic_sphere.json", o, false);
     expectPairedAgreement(off, on, "a ball inside the glass ball");
+}
+
+// The caustic scenes' fog, and milk inside the ball.
+const char* const GlobeOfMilk =
+    R"(media=[{"name": "fog", "type": "homogeneous", "sigma_a": 0.03, "sigma_s": 0.6, "g": 0.0,
+               "bounds": {"min": [-1.6, -0.8, -1.2], "max": [1.6, 0.25, 1.2]}},
+              {"name": "milk", "type": "homogeneous", "sigma_a": 0.2, "sigma_s": 1.5, "g": 0.5,
+               "bounds": {"min": [-0.5, 0.25, -0.5], "max": [0.5, 1.25, 0.5]}}])";
+
+std::vector<std::string> globeOfMilk(const char* lights) {
+    std::vector<std::string> o = CausticScene;
+    o.insert(o.end(), {GlobeOfMilk, R"(surfaces.0.interior="milk")", lights});
+    return o;
+}
+
+// A sphere light in the milk, off the ball's centre.
+const char* const LightInTheMilk =
+    R"(lights=[{"type": "sphere", "position": [0.08, 0.8, 0.05], "radius": 0.08, "power": [60, 55, 50]}])";
+
+TEST(SphereCausticRenders, ALightInAGlobeOfMilkAgreesWithPathsAlone) {
+    // The fog and the floor see it across the surface once, through the milk.
+    const auto o = globeOfMilk(LightInTheMilk);
+    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", o, false),
+                          renderWith("scenes/fig4_caustic_sphere.json", o, true), "a light in a globe of milk");
+}
+
+TEST(SphereCausticRenders, ALightOverAGlobeOfMilkAgreesWithPathsAlone) {
+    // The milk sees it across the surface once; the fog and the floor
+    // through the ball and its milk.
+    const auto o = globeOfMilk(LargeLight);
+    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", o, false),
+                          renderWith("scenes/fig4_caustic_sphere.json", o, true), "a light over a globe of milk");
+}
+
+TEST(SphereCausticRenders, PointLightsInAndOverAGlobeOfMilkAgreeWithSmallSphereLights) {
+    for (const char* at : {"[0.08, 0.8, 0.05]", "[0, 2.6, 0]", "[0, 0.75, 0]"}) {
+        const std::string point = "lights=[" + pointLight(at, "5") + "]";
+        const std::string sphere = "lights=[" + smallSphereLight(at, 5) + "]";
+        expectPairedAgreement(renderWith("scenes/fig4_caustic.json", globeOfMilk(sphere.c_str()), true),
+                              renderWith("scenes/fig4_caustic.json", globeOfMilk(point.c_str()), true),
+                              std::string("a point light at ") + at + " and a globe of milk");
+    }
+}
+
+TEST(SphereCausticRenders, GuidedMarcherConnectsThroughAGlobeOfMilkLikeThePathTracer) {
+    // Single scattering: no photons, the connections carry all the light
+    // of the point light over the ball to the milk and below it.
+    const std::string point = "lights=[" + pointLight("[0, 2.6, 0]", "23") + "]";
+    std::vector<std::string> o = globeOfMilk(point.c_str());
+    o[2] = "render.max_depth=1";
+    std::vector<std::string> guided = o;
+    guided[1] = "render.method=\"guided\"";
+    guided[3] = "render.spp=128";
+    const auto scene = buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), guided));
+    EXPECT_TRUE(scene->pointLightCaustics);
+    EXPECT_FALSE(illuminationRequest(*scene, Method::Guided, {}).indirect);
+    expectPairedAgreement(renderWith("scenes/fig4_caustic.json", o, true),
+                          renderWith("scenes/fig4_caustic.json", guided, true), "guided, a globe of milk");
+}
+
+TEST(SphereCaustics, ConnectedPhotonsInAndBelowAGlobeOfMilkCameAcrossOrThroughIt) {
+    // Photon::Connected in the milk: straight from the light across the
+    // ball's surface; below it: straight through the ball and its milk.
+    const std::string point = "lights=[" + pointLight("[0, 2.6, 0]", "23") + "]";
+    const auto scene = buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), globeOfMilk(point.c_str())));
+    ASSERT_TRUE(scene->pointLightCaustics);
+    const GlassSphere& ball = scene->glassSpheres.at(0);
+    const Vec3 light = scene->lights.at(0).desc().position;
+    size_t inside = 0, outside = 0, milk = 0;
+    for (const Photon& p : tracePhotons(*scene, 400000, 5).photons) {
+        const bool in = length(p.position - ball.center) < ball.radius;
+        milk += in;
+        if (!p.isConnected()) continue;
+        (in ? inside : outside) += 1;
+        SphereConnection tr;
+        const Vec3 back = -p.travelDirection();
+        ASSERT_TRUE(in ? traceAcrossSphere(ball, p.position, back, tr) : traceThroughSphere(ball, p.position, back, tr));
+        const Vec3 v = light - tr.p2;
+        EXPECT_GT(dot(v, tr.wo), 0.f);
+        // Within the 32-bit direction's precision, which refraction near
+        // grazing angles magnifies (a photon that scattered first would
+        // miss the light by far more).
+        EXPECT_LT(length(v - tr.wo * dot(v, tr.wo)), 1e-2f * length(v))
+            << "photon at " << p.position.x << " " << p.position.y << " " << p.position.z << (in ? " (in)" : "");
+    }
+    EXPECT_GT(inside, 100u);
+    EXPECT_GT(outside, 100u);
+    EXPECT_LT(inside, milk);  // what scattered in the milk first is not connected
 }
 
 }  // namespace

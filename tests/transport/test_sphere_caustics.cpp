@@ -2,7 +2,9 @@
 // connections against the traced rays, and the connection estimate of the
 // light a glass ball focuses from a sphere light onto a point against
 // brute force (directions drawn uniformly in the cone of the ball, traced
-// through it, counted where they hit the light).
+// through it, counted where they hit the light); the same for connections
+// across the ball's surface once (a light inside it seen from outside, a
+// light outside seen from inside).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -141,6 +143,160 @@ TEST(SphereCaustics, ConnectionEstimateMatchesBruteForceTracing) {
         EXPECT_NEAR(meanC, meanB, 4 * std::sqrt(seB * seB + seC * seC))
             << "x " << x.x << " " << x.y << " " << x.z << ": connections " << meanC << " +- " << seC << ", tracing "
             << meanB << " +- " << seB;
+    }
+}
+
+// A point inside the ball (within 0.9 of its radius) and one outside it.
+Vec3 insidePoint(const GlassSphere& s, Rng& rng) {
+    return s.center + sampleUniformSphere(rng.uniform(), rng.uniform()) * (0.9f * s.radius * std::cbrt(rng.uniform()));
+}
+Vec3 outsidePoint(Rng& rng) {
+    return Vec3(rng.uniform() * 3 - 1.5f, -0.8f + rng.uniform() * 3.0f, rng.uniform() * 3 - 1.5f);
+}
+
+TEST(SphereCaustics, EveryConnectionAcrossTheSurfacePassesThroughItsEndPoint) {
+    const GlassSphere s = ball();
+    Rng rng(5);
+    for (const bool fromInside : {false, true}) {
+        int tried = 0, found = 0, foundThorough = 0;
+        for (int i = 0; i < 2000; ++i) {
+            const Vec3 out = outsidePoint(rng);
+            if (!(length(out - s.center) > 1.05f * s.radius)) continue;
+            const Vec3 in = insidePoint(s, rng);
+            const Vec3 x = fromInside ? in : out, y = fromInside ? out : in;
+            ++tried;
+            SphereConnection c[MaxSphereConnections];
+            const int n = connectAcrossSphere(s, x, y, c);
+            found += n > 0;
+            SphereConnection ct[MaxSphereConnections];
+            const int nt = connectAcrossSphere(s, x, y, ct, true);
+            foundThorough += nt > 0;
+            // What the grid alone misses are paths that graze the ball
+            // outside, between its last point and the arc's end: little
+            // light passes there (and sphere lights weigh the connections
+            // against the paths' own hits).
+            if (nt > 0 && n == 0) EXPECT_LT(ct[0].transmission, 0.3f);
+            for (int k = 0; k < n; ++k) {
+                EXPECT_EQ(c[k].refractions, 1);
+                EXPECT_LT(missDistance(c[k], y), 1e-4) << "x " << x.x << " " << x.y << " " << x.z;
+                EXPECT_GT(dot(c[k].wo, y - c[k].p2), 0.f);
+                EXPECT_NEAR(length(c[k].p2 - s.center), s.radius, 1e-5f);
+                SphereConnection t;
+                ASSERT_TRUE(traceAcrossSphere(s, x, c[k].wi, t));
+                EXPECT_LT(length(t.p2 - c[k].p2), 1e-5f);
+                EXPECT_GT(c[k].spreading, 0.0);
+                EXPECT_GT(c[k].transmission, 0.f);
+                EXPECT_LE(c[k].transmission, 1.f);
+            }
+        }
+        // The rays refracted into the ball from a point outside fill only
+        // part of it (beyond the rays at the critical angle lies a shadow),
+        // so about three quarters of the pairs connect.
+        EXPECT_GT(found, tried / 2) << (fromInside ? "from inside" : "from outside");
+        EXPECT_GE(found, 0.95 * foundThorough) << (fromInside ? "from inside" : "from outside");
+    }
+}
+
+// Paths traced across the surface from a point (inside the ball, or
+// outside it), then found again from points along them on the other side.
+TEST(SphereCaustics, TheSolverFindsEveryTracedPathAcrossTheSurface) {
+    const GlassSphere s = ball();
+    for (const Vec3 y : {Vec3(0.1f, 0.8f, -0.05f), s.center, Vec3(0.f, 2.6f, 0.f), Vec3(0.6f, 0.2f, 0.3f)}) {
+        const bool yInside = length(y - s.center) < s.radius;
+        Rng rng(9);
+        int tried = 0, missed = 0;
+        for (int i = 0; i < 5000; ++i) {
+            Vec3 w;
+            if (yInside) w = sampleUniformSphere(rng.uniform(), rng.uniform());
+            else {
+                const float sin2 = s.radius * s.radius / lengthSquared(s.center - y);
+                w = sampleUniformCone(normalize(s.center - y), std::sqrt(1 - sin2), rng.uniform(), rng.uniform());
+            }
+            SphereConnection t;
+            if (!traceAcrossSphere(s, y, w, t)) continue;
+            // A point on the ray beyond the surface: outside, up to 2.5
+            // away; inside, before the chord's end.
+            float along;
+            if (yInside) along = 0.05f + 2.5f * rng.uniform();
+            else {
+                const float chord = -2 * dot(t.p2 - s.center, t.wo);
+                if (!(chord > 0.02f)) continue;
+                along = (0.01f + 0.98f * rng.uniform()) * chord;
+            }
+            const Vec3 x = t.p2 + t.wo * along;
+            ++tried;
+            SphereConnection c[MaxSphereConnections];
+            const int n = connectAcrossSphere(s, x, y, c, true);
+            float best = -1;
+            for (int k = 0; k < n; ++k) best = std::max(best, dot(c[k].wi, -t.wo));
+            missed += !(best > 0.99999f);
+            if (!(best > 0.99999f) && missed <= 4)
+                ADD_FAILURE() << "no root for the path through x = " << x.x << " " << x.y << " " << x.z << " (" << n
+                              << " found)";
+        }
+        EXPECT_GT(tried, 3000);
+        EXPECT_EQ(missed, 0) << "of " << tried << " from " << y.x << " " << y.y << " " << y.z;
+    }
+}
+
+// The integral over directions at x of L_e [the ray across the surface hits
+// the light] (1 - F), by brute force and by connections to points drawn on
+// the light, for a light inside the ball seen from outside and a light
+// outside seen from inside.
+TEST(SphereCaustics, ConnectionAcrossTheSurfaceMatchesBruteForceTracing) {
+    const GlassSphere s = ball();
+    struct Case {
+        Vec3 x, lightC;
+        float rl;
+    };
+    const Case cases[] = {{Vec3(0.f, -0.3f, 0.f), Vec3(0.1f, 0.8f, 0.05f), 0.08f},
+                          {Vec3(0.7f, 0.9f, 0.4f), Vec3(-0.05f, 0.7f, 0.f), 0.1f},
+                          {Vec3(0.1f, 0.6f, 0.1f), Vec3(0.f, 2.6f, 0.f), 0.3f},
+                          {Vec3(-0.2f, 0.9f, 0.f), Vec3(1.2f, 0.4f, 0.3f), 0.2f}};
+    for (const Case& cs : cases) {
+        const bool xInside = length(cs.x - s.center) < s.radius;
+        // Brute force: w uniform over the sphere (inside) or in the ball's cone.
+        const float sin2 = xInside ? 1.f : s.radius * s.radius / lengthSquared(s.center - cs.x);
+        const float cosMax = xInside ? -1.f : std::sqrt(1 - sin2);
+        const Vec3 axis = xInside ? Vec3(0, 0, 1) : normalize(s.center - cs.x);
+        const double dirPdf = 1 / (2 * double(Pi) * (1 - double(cosMax)));
+        Rng rng(13);
+        const int nb = 1000000;
+        double sumB = 0, sumB2 = 0;
+        for (int i = 0; i < nb; ++i) {
+            const Vec3 w = sampleUniformCone(axis, cosMax, rng.uniform(), rng.uniform());
+            SphereConnection t;
+            double v = 0;
+            if (traceAcrossSphere(s, cs.x, w, t)) {
+                const Vec3 oc = t.p2 - cs.lightC;
+                const float b = dot(t.wo, oc), c = dot(oc, oc) - cs.rl * cs.rl;
+                if (c > 0 && b < 0 && b * b - c > 0) v = double(t.transmission) / dirPdf;
+            }
+            sumB += v;
+            sumB2 += v * v;
+        }
+        const double meanB = sumB / nb, seB = std::sqrt((sumB2 / nb - meanB * meanB) / nb);
+        const int nc = 100000;
+        double sumC = 0, sumC2 = 0;
+        const double pA = 1 / (4 * double(Pi) * cs.rl * cs.rl);
+        for (int i = 0; i < nc; ++i) {
+            const Vec3 ny = sampleUniformSphere(rng.uniform(), rng.uniform());
+            const Vec3 y = cs.lightC + ny * cs.rl;
+            SphereConnection c[MaxSphereConnections];
+            const int n = connectAcrossSphere(s, cs.x, y, c);
+            double v = 0;
+            for (int k = 0; k < n; ++k) {
+                const double cosY = -double(dot(c[k].wo, ny));
+                if (cosY > 0) v += double(c[k].transmission) * cosY / (pA * c[k].spreading);
+            }
+            sumC += v;
+            sumC2 += v * v;
+        }
+        const double meanC = sumC / nc, seC = std::sqrt((sumC2 / nc - meanC * meanC) / nc);
+        ASSERT_GT(meanB, 0);
+        EXPECT_NEAR(meanC, meanB, 4 * std::sqrt(seB * seB + seC * seC))
+            << "x " << cs.x.x << " " << cs.x.y << " " << cs.x.z << ": connections " << meanC << " +- " << seC
+            << ", tracing " << meanB << " +- " << seB;
     }
 }
 
