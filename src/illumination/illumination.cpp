@@ -218,11 +218,11 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     }
     if (rs.li == LiSource::Photons) rq.indirect = rs.maxDepth > 1 || bendingGlass;
     if (rs.li == LiSource::Path) {
-        // Caustics of point and spot lights through glass spheres come from
-        // sphere caustic connections where Scene::pointLightCaustics holds.
-        rq.indirect = (bendingGlass && deltaLight && !scene.pointLightCaustics) || (pointLight && rs.maxDepth > 1);
+        // Caustics of delta lights through glass spheres come from sphere
+        // caustic connections where Scene::deltaLightCaustics holds.
+        rq.indirect = (bendingGlass && deltaLight && !scene.deltaLightCaustics) || (pointLight && rs.maxDepth > 1);
         rq.causticsOnly = true;
-        rq.exceptConnected = scene.pointLightCaustics;
+        rq.exceptConnected = scene.deltaLightCaustics;
         rq.pointLightsByPhotons = pointLight && rq.indirect;
     }
     return rq;

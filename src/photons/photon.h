@@ -49,8 +49,8 @@ struct Photon {
         Caustic = 2u,  // from a delta light through a bending surface before any scattering:
                        // no path with next-event estimation finds this light
         FromPointLight = 4u,  // emitted by a point or spot light
-        // A caustic that sphere caustic connections find (Scene::pointLightCaustics):
-        // from a point or spot light through one glass sphere (in and out),
+        // A caustic that sphere caustic connections find (Scene::deltaLightCaustics):
+        // from a delta light through one glass sphere (in and out),
         // or across its surface once, with no other event before it landed.
         Connected = 8u,
     };

@@ -95,7 +95,7 @@ private:
         // refractions at one glass sphere (Photon::Connected after one,
         // across its surface, or two, through it), -1 once anything else
         // happened.
-        int lensSphere = -1, lensRefractions = mScene.pointLightCaustics && src.pointLight ? 0 : -1;
+        int lensSphere = -1, lensRefractions = mScene.deltaLightCaustics && src.deltaLight ? 0 : -1;
         Color beta(1);  // throughput relative to the emitted power
         MediumPoint mp;
         while (true) {

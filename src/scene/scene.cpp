@@ -92,11 +92,11 @@ void findGlassSpheres(Scene& scene) {
 }
 
 // A path tracer cannot reach a delta light through refracting glass, except
-// point and spot lights through glass spheres (Scene::pointLightCaustics):
-// a render by one says what it misses.
+// through glass spheres (Scene::deltaLightCaustics): a render by one says
+// what it misses.
 void warnOfMissedCaustics(const Scene& scene) {
     const SceneDesc& desc = scene.desc;
-    if (!isPathTracer(desc.render.method) || scene.pointLightCaustics) return;
+    if (!isPathTracer(desc.render.method) || scene.deltaLightCaustics) return;
     bool deltaLight = false, glassWithMedium = false;
     for (const Light& l : scene.lights) deltaLight = deltaLight || l.isDelta();
     for (const auto& s : desc.surfaces)
@@ -106,35 +106,40 @@ void warnOfMissedCaustics(const Scene& scene) {
     if (glassWithMedium)
         warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
                             "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
-                            "light in the reference, except from point and spot lights through glass spheres with "
-                            "render.sphere_caustics; use sphere lights where the reference must converge"));
+                            "light in the reference, except through glass spheres with render.sphere_caustics; use "
+                            "sphere lights where the reference must converge"));
     else if (hasBendingGlass(scene))
         warn(str(desc.file, ": the caustics of a delta light (point, spot, directional or collimated_quad) "
                             "through refracting glass are missing from a unidirectional path tracer, except "
-                            "those of point and spot lights through glass spheres with render.sphere_caustics "
-                            "(docs/method.md, \"Caustics through glass spheres\"); use sphere lights where the "
-                            "reference must converge"));
+                            "through glass spheres with render.sphere_caustics (docs/method.md, \"Caustics through "
+                            "glass spheres\"); use sphere lights where the reference must converge"));
 }
 
-// Scene::pointLightCaustics.
-bool connectsPointLightCaustics(const Scene& scene) {
+// Scene::deltaLightCaustics.
+bool connectsDeltaLightCaustics(const Scene& scene) {
     if (!scene.desc.render.sphereCaustics) return false;
     for (size_t i = 0; i < scene.surfaces.size(); ++i) {
         const SurfaceInfo& info = scene.surfaces[i];
         const bool bends = info.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(info.material);
         if (bends && glassSphereOf(scene, int(i)) < 0) return false;
     }
-    bool pointLike = false;
+    bool delta = false;
     for (const Light& l : scene.lights) {
         if (!l.isDelta()) continue;
-        if (!l.isPointLike()) return false;
-        pointLike = true;
-        // Inside a sphere or outside all, off their surfaces (where the
-        // connections' roots would not be found).
-        for (const GlassSphere& g : scene.glassSpheres)
-            if (!(std::fabs(length(l.desc().position - g.center) - g.radius) > 1e-4f * g.radius)) return false;
+        delta = true;
+        const LightDesc& d = l.desc();
+        for (const GlassSphere& g : scene.glassSpheres) {
+            if (l.isPointLike()) {
+                // Inside a sphere or outside all, off their surfaces (where
+                // the connections' roots would not be found).
+                if (!(std::fabs(length(d.position - g.center) - g.radius) > 1e-4f * g.radius)) return false;
+            } else if (d.type == LightDesc::Type::CollimatedQuad) {
+                // The quad outside every ball (its beam then enters from outside).
+                if (!(length(d.center - g.center) > g.radius + 0.5f * (length(d.u) + length(d.v)))) return false;
+            }
+        }
     }
-    return pointLike;
+    return delta;
 }
 
 // Scene::shadowRaysCanReach. A region is sealed when every surface that
@@ -297,7 +302,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     scene->shadowStep = desc.render.shadowStep > 0 ? desc.render.shadowStep : scene->step;
     computeShadowReach(*scene);
     findGlassSpheres(*scene);
-    scene->pointLightCaustics = connectsPointLightCaustics(*scene);
+    scene->deltaLightCaustics = connectsDeltaLightCaustics(*scene);
     warnOfMissedCaustics(*scene);
     return scene;
 }

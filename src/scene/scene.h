@@ -73,13 +73,13 @@ public:
     float sceneScale = 1;            // size of the scene, for ray offsets
     bool hasSphereLights = false;
     std::vector<GlassSphere> glassSpheres;
-    // The caustics of point and spot lights through the scene's refracting
-    // glass are found by sphere caustic connections (sphere_caustics.h), so
-    // no photon needs to carry them: render.sphere_caustics, every
-    // refracting surface one of glassSpheres, at least one point or spot
-    // light and every delta light a point or spot off the spheres' surfaces
-    // (inside one or outside all).
-    bool pointLightCaustics = false;
+    // The caustics of delta lights through the scene's refracting glass are
+    // found by sphere caustic connections (sphere_caustics.h), so no photon
+    // needs to carry them: render.sphere_caustics, every refracting surface
+    // one of glassSpheres, at least one delta light, every point or spot off
+    // the spheres' surfaces (inside one or outside all), every collimated
+    // quad outside them (directional lights always are).
+    bool deltaLightCaustics = false;
 
     // Whether a shadow ray that starts in `region` can ever reach light
     // `light` (lights.size(): the environment). False only where every

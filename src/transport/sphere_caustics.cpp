@@ -101,11 +101,13 @@ constexpr double RootMatchCos = 1 - 1e-6;
 
 // G by forward differences from the traced path `base` of w (their error,
 // O(eps) relative, is far below the noise of any estimate); `trace` is the
-// pattern's tracer (trace or traceAcross).
+// pattern's tracer (trace or traceAcross). Without y (a light at
+// infinity), J = d omega_exit / d omega(x) instead, the solid angle the exit
+// directions spread over.
 template <class Trace>
-double spreading(Trace&& trace, const GlassSphere& s, const D3& x, const D3& w, const D3& y, const Traced& base) {
+double spreading(Trace&& trace, const GlassSphere& s, const D3& x, const D3& w, const D3* y, const Traced& base) {
     // The exit ray of w perturbed by (u, v) in a tangent frame, met with the
-    // plane through y perpendicular to the exit direction.
+    // plane through y perpendicular to the exit direction (or its direction).
     const D3 helper = std::fabs(w.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0);
     const D3 t1 = normalize(cross(w, helper)), t2 = cross(w, t1);
     const double eps = 1e-6;
@@ -113,11 +115,16 @@ double spreading(Trace&& trace, const GlassSphere& s, const D3& x, const D3& w, 
     for (int k = 0; k < 2; ++k) {
         Traced tr;
         if (!trace(s, x, normalize(w + (k == 0 ? t1 : t2) * eps), tr)) return 0;
+        if (!y) {
+            q[k] = tr.wo - base.wo;
+            continue;
+        }
         const double den = dot(tr.wo, base.wo);
         if (!(den > 0)) return 0;
-        q[k] = tr.p2 + tr.wo * (dot(y - tr.p2, base.wo) / den);
+        q[k] = tr.p2 + tr.wo * (dot(*y - tr.p2, base.wo) / den);
     }
-    const D3 q0 = base.p2 + base.wo * dot(y - base.p2, base.wo);
+    if (!y) return length(cross(q[0], q[1])) / (eps * eps);
+    const D3 q0 = base.p2 + base.wo * dot(*y - base.p2, base.wo);
     return length(cross(q[0] - q0, q[1] - q0)) / (eps * eps);
 }
 
@@ -169,6 +176,17 @@ struct ArcEval {
     bool ok = false;
     double h = 0, ahead = 0;
 };
+
+// Where the point (i1, i2) lies from the ray from (px, py) along (dx, dy):
+// h its side (0 on the ray), ahead how far along it.
+inline ArcEval pointFromRay(double px, double py, double dx, double dy, double i1, double i2) {
+    ArcEval e;
+    const double tx = i1 - px, ty = i2 - py;
+    e.ok = true;
+    e.h = dx * ty - dy * tx;
+    e.ahead = dx * tx + dy * ty;
+    return e;
+}
 
 // The roots of h over the arc |a| < aMax of the ball's outline, h given as
 // evalCS(cos a, sin a); keep(a, h(a)) takes each. A grid brackets them and
@@ -347,7 +365,7 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
             std::fabs(r.h) < 1e-6 * length(y - tr.p2)) {
             // 0 where a ray beside it misses the ball (grazing, where the
             // Fresnel transmission vanishes): no usable connection.
-            const double G = spreading(trace, s, x, w, y, tr);
+            const double G = spreading(trace, s, x, w, &y, tr);
             if (G > 0 || !thorough) out[n++] = toConnection(w, tr, G, 2);
         }
     });
@@ -380,12 +398,7 @@ int connectAcrossSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, Sp
         ArcEval e;
         PlaneEntry in;
         if (!enterInPlane(R, dO, eta, ca, sa, in)) return e;
-        const double d1x = in.d1x, d1y = in.d1y;
-        const double tx = i1 - R * ca, ty = i2 - R * sa;
-        e.ok = true;
-        e.h = d1x * ty - d1y * tx;
-        e.ahead = d1x * tx + d1y * ty;
-        return e;
+        return pointFromRay(R * ca, R * sa, in.d1x, in.d1y, i1, i2);
     };
     int n = 0;
     auto keep = [&](double root, const ArcEval& r) {
@@ -398,7 +411,7 @@ int connectAcrossSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, Sp
         if (!traceAcross(s, x, w, tr)) return;
         const D3 toY = y - tr.p2;
         if (!(dot(toY, tr.wo) > 0) || !(length(cross(tr.wo, toY)) < 1e-6 * length(toY))) return;
-        const double G = spreading(traceAcross, s, x, w, y, tr);
+        const double G = spreading(traceAcross, s, x, w, &y, tr);
         if (G > 0 || !thorough) out[n++] = toConnection(w, tr, G, 1);
     };
     if (onAxis) keep(0.0, evalCS(1.0, 0.0));
@@ -406,8 +419,88 @@ int connectAcrossSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, Sp
     return n;
 }
 
+int connectThroughSphereToward(const GlassSphere& s, const Vec3& xf, const Vec3& wLf,
+                               SphereConnection out[MaxSphereConnections]) {
+    const D3 c(s.center), x(xf), L = normalize(D3(wLf));
+    const double R = s.radius;
+    const double dx = length(x - c);
+    if (!(dx > R * (1 + 1e-6))) return 0;
+    // The plane of x, the centre and the light's direction.
+    const D3 e1 = (x - c) * (1 / dx);
+    const D3 lPerp = L - e1 * dot(L, e1);
+    const double lh = length(lPerp);
+    if (!(lh > 1e-9)) return 0;  // x on the axis through the centre: a ring of paths, measure zero
+    const D3 e2 = lPerp * (1 / lh);
+    const double l1 = dot(L, e1), l2 = lh, eta = s.ior;
+    const double aMax = std::acos(R / dx);
+    // h(a): the sine of the angle from the exit direction to the light's.
+    auto evalCS = [&](double ca, double sa) {
+        ArcEval e;
+        PlaneEntry in;
+        if (!enterInPlane(R, dx, eta, ca, sa, in)) return e;
+        const double chord = -2 * R * (ca * in.d1x + sa * in.d1y);
+        if (!(chord > 0)) return e;
+        const double p2x = R * ca + in.d1x * chord, p2y = R * sa + in.d1y * chord;
+        const double k2 = (eta * in.cosT - in.cosI) / R;
+        const double d2x = eta * in.d1x - p2x * k2, d2y = eta * in.d1y - p2y * k2;
+        e.ok = true;
+        e.h = d2x * l2 - d2y * l1;
+        e.ahead = d2x * l1 + d2y * l2;
+        return e;
+    };
+    int n = 0;
+    solveOnArc(aMax, true, lh < 0.1, evalCS, [&](double root, const ArcEval& r) {
+        if (!(n < MaxSphereConnections && r.ok && r.ahead > 0)) return;
+        const D3 w = normalize(c + (e1 * std::cos(root) + e2 * std::sin(root)) * R - x);
+        Traced tr;
+        if (!trace(s, x, w, tr) || !(dot(tr.wo, L) > 0) || !(length(cross(tr.wo, L)) < 1e-6)) return;
+        const double J = spreading(trace, s, x, w, nullptr, tr);
+        if (J > 0) out[n++] = toConnection(w, tr, J, 2);
+    });
+    return n;
+}
+
+int connectAcrossSphereToward(const GlassSphere& s, const Vec3& xf, const Vec3& wLf,
+                              SphereConnection out[MaxSphereConnections]) {
+    const D3 c(s.center), x(xf), L = normalize(D3(wLf));
+    const double R = s.radius;
+    const D3 cx = x - c;
+    if (!(length(cx) < R * (1 - 1e-6))) return 0;
+    // The light's rays enter on the half of the ball facing it: the entry
+    // point at angle a from the direction towards the light, in the plane
+    // of that direction, the centre and x.
+    const D3 e1 = L;
+    const D3 xPerp = cx - e1 * dot(cx, e1);
+    const double xh = length(xPerp);
+    const bool onAxis = !(xh > 1e-9 * R);
+    const D3 e2 = onAxis ? normalize(cross(e1, std::fabs(e1.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0))) : xPerp * (1 / xh);
+    const double i1 = dot(cx, e1), i2 = onAxis ? 0.0 : xh, eta = s.ior;
+    // h(a): which side of the refracted ray x lies; the ray arrives along -e1.
+    auto evalCS = [&](double ca, double sa) {
+        ArcEval e;
+        const double cosI = ca;
+        if (!(cosI > 0)) return e;
+        const double cosT = std::sqrt(1 - (1 - cosI * cosI) / (eta * eta));
+        const double k1 = cosI / eta - cosT;
+        return pointFromRay(R * ca, R * sa, -1 / eta + ca * k1, sa * k1, i1, i2);
+    };
+    int n = 0;
+    auto keep = [&](double root, const ArcEval& r) {
+        if (!(n < MaxSphereConnections && r.ok && r.ahead > 0)) return;
+        const D3 p = c + (e1 * std::cos(root) + e2 * std::sin(root)) * R;
+        const D3 w = normalize(p - x);
+        Traced tr;
+        if (!traceAcross(s, x, w, tr) || !(dot(tr.wo, L) > 0) || !(length(cross(tr.wo, L)) < 1e-6)) return;
+        const double J = spreading(traceAcross, s, x, w, nullptr, tr);
+        if (J > 0) out[n++] = toConnection(w, tr, J, 1);
+    };
+    if (onAxis) keep(0.0, evalCS(1.0, 0.0));
+    else solveOnArc(0.5 * double(Pi), true, xh < 0.1 * length(cx), evalCS, keep);
+    return n;
+}
+
 bool sceneHasSphereCaustics(const Scene& scene) {
-    return (scene.hasSphereLights || scene.pointLightCaustics) && scene.desc.render.sphereCaustics &&
+    return (scene.hasSphereLights || scene.deltaLightCaustics) && scene.desc.render.sphereCaustics &&
            !scene.glassSpheres.empty();
 }
 
@@ -421,7 +514,10 @@ namespace {
 int connectionPattern(const GlassSphere& s, const Light& l, const Vec3& x) {
     const bool xInside = lengthSquared(x - s.center) < s.radius * s.radius;
     bool inside, outside;
-    if (l.isPointLike()) {
+    if (l.isDelta() && !l.isPointLike()) {
+        inside = false;  // directional, or a collimated quad outside the balls (Scene::deltaLightCaustics)
+        outside = true;
+    } else if (l.isPointLike()) {
         const float d = length(l.desc().position - s.center);
         inside = d < s.radius;
         outside = d > s.radius;
@@ -497,7 +593,9 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
         const double pc = xInside ? 0.0 : ballConePdf(s, v.p, &cosMax);
         // What reaches x from y along the connection cn: transmittance
         // x -> p1, through the ball's medium (two refractions), p2 -> y.
-        auto throughBall = [&](const SphereConnection& cn, const Vec3& y) {
+        // `farDist`: how far beyond p2 the light is (Infinity: directional),
+        // else |y - p2|.
+        auto throughBall = [&](const SphereConnection& cn, const Vec3& y, float farDist = -1.f) {
             const float d1 = length(cn.p1 - origin);
             Color T = shadowTransmittance(ctx, region, origin, cn.wi, d1, rng, estimator);
             if (isBlack(T)) return T;
@@ -505,8 +603,8 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             if (cn.refractions == 1) {
                 // p -> y on the other side (the light's own surface ends the shadow ray).
                 const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
-                return T * shadowTransmittance(ctx, xInside ? s.outside : s.inside, o2, cn.wo, length(y - o2), rng,
-                                               estimator);
+                return T * shadowTransmittance(ctx, xInside ? s.outside : s.inside, o2, cn.wo,
+                                               farDist >= 0 ? farDist : length(y - o2), rng, estimator);
             }
             const Vec3 n1 = normalize(cn.p1 - s.center);
             const Vec3 d = normalize(cn.p2 - cn.p1);
@@ -520,13 +618,34 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             }
             // p2 -> y: the light's own surface ends the shadow ray.
             const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
-            return T * shadowTransmittance(ctx, s.outside, o2, cn.wo, length(y - o2), rng, estimator);
+            return T * shadowTransmittance(ctx, s.outside, o2, cn.wo, farDist >= 0 ? farDist : length(y - o2), rng,
+                                           estimator);
         };
         for (const Light& light : scene.lights) {
             const int pattern = connectionPattern(s, light, v.p);
             if (pattern == 0) continue;
+            if (light.isDelta() && !light.isPointLike()) {
+                if (!scene.deltaLightCaustics || !lights.parallelLights) continue;
+                // A light at infinity (directional, or a collimated quad's
+                // beam): every root whose exit direction is the light's,
+                // each f E T (1 - F...) / J.
+                const Vec3 wL = normalize(-light.desc().direction);
+                const int n = pattern == 2 ? connectThroughSphereToward(s, v.p, wL, roots)
+                                           : connectAcrossSphereToward(s, v.p, wL, roots);
+                for (int k = 0; k < n; ++k) {
+                    const SphereConnection& cn = roots[k];
+                    LightSample ls;  // the quad's beam must hold p2
+                    if (!light.sample(cn.p2, 0.f, 0.f, ls)) continue;
+                    const Color f = v.f(cn.wi);
+                    if (isBlack(f) || isBlack(ls.L)) continue;
+                    const Color T = throughBall(cn, cn.p2, ls.dist);
+                    if (isBlack(T)) continue;
+                    L += f * ls.L * T * float(double(cn.transmission) / cn.spreading);
+                }
+                continue;
+            }
             if (light.isPointLike()) {
-                if (!scene.pointLightCaustics || !lights.pointLights) continue;
+                if (!scene.deltaLightCaustics || !lights.pointLights) continue;
                 // Every root to the light's one point y: f I T (1 - F1)(1 - F2) / G.
                 const Vec3 y = light.desc().position;
                 const int n = connect(s, pattern, v.p, y, roots, true);

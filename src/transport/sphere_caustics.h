@@ -20,7 +20,7 @@
 // the traced rays in double precision. Its solid-angle density at x is
 // p_m = p_A G / |cos theta_y|.
 //
-// A point or spot light (Scene::pointLightCaustics) is its one point y:
+// A point or spot light (Scene::deltaLightCaustics) is its one point y:
 // each root brings f(w) I(y -> p2) T (1 - F1)(1 - F2) / G, the limit of the
 // above for a sphere light of intensity I shrunk to a point; no path or cone
 // direction can hit it, so there is nothing to weigh it against.
@@ -57,7 +57,7 @@ struct SphereConnection {
     Vec3 p1, p2;         // entry and exit points
     Vec3 wo;             // unit, from p2 towards y
     float transmission;  // (1 - F1)(1 - F2), the Fresnel transmittances
-    double spreading;    // G = dA_perp(y) / d omega(x)
+    double spreading;    // G = dA_perp(y) / d omega(x); to a light at infinity, d omega_exit / d omega(x)
     int refractions;     // 2: into the ball and out; 1: across its surface (p1 = p2)
 };
 
@@ -86,6 +86,16 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, Sph
 int connectAcrossSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections],
                         bool thorough = false);
 
+// Every connection from x to a light at infinity in direction wL (unit,
+// towards the light: directional and collimated lights) through sphere s
+// from outside it (two refractions), or across its surface from inside it
+// (one); solved thoroughly. Each connection's `spreading` is then
+// J = d omega_exit / d omega(x), and its estimate f E T (1 - F...) / J.
+int connectThroughSphereToward(const GlassSphere& s, const Vec3& x, const Vec3& wL,
+                               SphereConnection out[MaxSphereConnections]);
+int connectAcrossSphereToward(const GlassSphere& s, const Vec3& x, const Vec3& wL,
+                              SphereConnection out[MaxSphereConnections]);
+
 // Traces direction w from x into sphere s and out again (double precision):
 // the exit point and direction, the Fresnel transmittances. False when the
 // ray misses the sphere.
@@ -102,15 +112,17 @@ bool traceAcrossSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, Spher
 // and the cone directions share the light between them alone).
 struct CausticLights {
     bool sphereLights = true;
-    bool pointLights = true;  // where Scene::pointLightCaustics holds
+    bool pointLights = true;     // where Scene::deltaLightCaustics holds
     bool pathFollows = true;
+    bool parallelLights = true;  // directional and collimated, where Scene::deltaLightCaustics holds
 };
 
 // The caustic light at vertex v (in `region`) through every glass sphere:
 // from sphere lights, the connections to one light point (and through the
 // ball, one direction in its cone), each weighed against the other and the
 // path's own hits; from point and spot lights, the connections to their
-// point.
+// point; from directional and collimated lights, those along their
+// direction.
 Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
                          TransmittanceEstimator estimator, const CausticLights& lights = {});
 
@@ -137,7 +149,7 @@ inline void followLensPattern(const Scene& scene, bool refraction, int surface, 
 }
 
 // True when sphere caustic connections apply (render.sphere_caustics, a
-// sphere light or Scene::pointLightCaustics, a glass sphere): every vertex
+// sphere light or Scene::deltaLightCaustics, a glass sphere): every vertex
 // then makes them, through each sphere by where it and the light lie, so a
 // path's weights (sphereCausticPathWeight) know what its last vertex did.
 bool sceneHasSphereCaustics(const Scene& scene);

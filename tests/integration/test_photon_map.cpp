@@ -209,7 +209,7 @@ namespace {
 // marchers' map (render.li = "path") then leaves them out, and only those.
 TEST(PhotonTracing, ConnectedPhotonsAreTheCausticsTheConnectionsFind) {
     auto scene = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {}));
-    ASSERT_TRUE(scene->pointLightCaustics);
+    ASSERT_TRUE(scene->deltaLightCaustics);
     const PhotonSet set = tracePhotons(*scene, 100000, 5);
     const GlassSphere& ball = scene->glassSpheres.at(0);
     const Vec3 light = scene->lights.at(0).desc().position;
@@ -234,7 +234,7 @@ TEST(PhotonTracing, ConnectedPhotonsAreTheCausticsTheConnectionsFind) {
     const IlluminationRequest rq = illuminationRequest(*scene, Method::Guided);
     EXPECT_TRUE(rq.exceptConnected);
     const auto off = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {"render.sphere_caustics=false"}));
-    EXPECT_FALSE(off->pointLightCaustics);
+    EXPECT_FALSE(off->deltaLightCaustics);
     EXPECT_FALSE(illuminationRequest(*off, Method::Guided).exceptConnected);
     for (const Photon& p : tracePhotons(*off, 20000, 5).photons) EXPECT_FALSE(p.isConnected());
 }
