@@ -33,7 +33,7 @@ TEST(AutoMethod, IsTheDefaultAndFollowsTheRule) {
     // Single scattering: guided.
     d = parse(scene(kSun, "", "{}"));
     EXPECT_EQ(d.render.method, Method::Guided);
-    // A delta light and refracting glass (caustics need photons): guided.
+    // A delta light and refracting glass (photons carry its caustics): guided.
     const std::string glass = R"({"shape": "sphere", "material": {"type": "dielectric", "ior": 1.5}})";
     d = parse(scene(kSun, glass, R"({"max_depth": 8})"));
     EXPECT_EQ(d.render.method, Method::Guided);
