@@ -23,7 +23,10 @@
 // A point or spot light (Scene::deltaLightCaustics) is its one point y:
 // each root brings f(w) I(y -> p2) T (1 - F1)(1 - F2) / G, the limit of the
 // above for a sphere light of intensity I shrunk to a point; no path or cone
-// direction can hit it, so there is nothing to weigh it against.
+// direction can hit it, so there is nothing to weigh it against. A
+// directional or collimated light is a direction: each root whose exit
+// direction is the light's brings f(w) E T (1 - F1)(1 - F2) / J, J the
+// exit directions' solid angle per solid angle at x.
 //
 // Near the lens's focus G goes to 0 and these estimates grow without bound;
 // there a direction drawn uniformly in the cone the ball subtends (density
@@ -135,7 +138,8 @@ float sphereCausticPathWeight(const Scene& scene, int sphere, int refractions, i
                               float pathPdf, const Vec3& y);
 
 // The pattern of a sphere caustic connection along a light path: refractions
-// into and out of one glass sphere and nothing else. After each bending
+// at one glass sphere (into and out of it, or across its surface once) and
+// nothing else. After each bending
 // surface event (a refraction or reflection at `surface`), `refractions`
 // counts the refractions at sphere `sphere`, or is -1 once anything else
 // broke the pattern (it stays -1).
