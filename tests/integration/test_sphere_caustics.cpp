@@ -19,7 +19,9 @@
 // A globe of milk (the ball holding a medium): lights inside it reached
 // across its surface once from outside, lights over it reached from the
 // milk across the surface and through the milk from the fog; the same
-// agreements.
+// agreements. The sun (directional and collimated lights): a collimated beam
+// holding the ball adds what the sun adds, and what the connections add
+// matches what the guided marcher's caustic photons add.
 #include <gtest/gtest.h>
 
 #include <cmath>
