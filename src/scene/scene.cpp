@@ -85,8 +85,11 @@ void findGlassSpheres(Scene& scene) {
         g.surface = int(i);
         g.outside = info.exteriorRegion;
         g.inside = info.interiorRegion;
+        g.emptyInside = scene.regions[size_t(g.inside)].media.empty();
         for (size_t j = 0; j < scene.surfaces.size(); ++j)
-            if (j != i && scene.surfaceSet->mayComeWithin(int(j), g.center, g.radius)) g.clearInside = false;
+            if (j != i && scene.surfaceSet->mayComeWithin(int(j), g.center, g.radius)) g.emptyInside = false;
+        for (const Light& l : scene.lights)
+            if (l.isSphere() && length(l.desc().position - g.center) < g.radius + l.desc().radius) g.emptyInside = false;
         scene.glassSpheres.push_back(g);
     }
 }

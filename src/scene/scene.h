@@ -42,7 +42,7 @@ struct GlassSphere {
     int surface = -1;
     int outside = 0;          // the region around it
     int inside = 0;           // the region it holds (its medium, if any)
-    bool clearInside = true;  // no other surface comes inside it
+    bool emptyInside = true;  // no medium, other surface or sphere light inside: rays cross it unhindered
 };
 
 // True when a straight shadow ray crosses the surface (interfaces and

@@ -170,6 +170,37 @@ inline bool enterInPlane(double R, double dx, double eta, double ca, double sa, 
     return true;
 }
 
+// The entered ray continued through the ball and out of it: the exit point
+// and direction. In closed form: inside, the angle to the normal is theta_t
+// at both ends, so the exit's transmitted cosine is cos theta_i.
+struct PlaneExit {
+    double p2x, p2y, d2x, d2y;
+};
+inline bool exitInPlane(double R, double eta, double ca, double sa, const PlaneEntry& in, PlaneExit& e) {
+    const double chord = -2 * R * (ca * in.d1x + sa * in.d1y);
+    if (!(chord > 0)) return false;
+    e.p2x = R * ca + in.d1x * chord;
+    e.p2y = R * sa + in.d1y * chord;
+    const double k2 = (eta * in.cosT - in.cosI) / R;  // n2 = p2 / R
+    e.d2x = eta * in.d1x - e.p2x * k2;
+    e.d2y = eta * in.d1y - e.p2y * k2;
+    return true;
+}
+
+// The unit e2 perpendicular to unit e1 in the plane of e1 and v, and the
+// length of v's part along it; false where that part is not above `tol` (v
+// on e1's axis), e2 then any perpendicular.
+bool planeAround(const D3& e1, const D3& v, double tol, D3& e2, double& vPerp) {
+    const D3 p = v - e1 * dot(v, e1);
+    vPerp = length(p);
+    if (vPerp > tol) {
+        e2 = p * (1 / vPerp);
+        return true;
+    }
+    e2 = normalize(cross(e1, std::fabs(e1.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0)));
+    return false;
+}
+
 // h on the outline at angle a: which side of the ray after the glass the
 // far end lies (0 on a root), and how far ahead of the ray's start.
 struct ArcEval {
@@ -324,10 +355,9 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
     // The plane of x, y and the centre: e1 towards x, e2 towards y's side.
     const D3 e1 = cx * (1 / dx);
     const D3 cy = y - c;
-    const D3 yPerp = cy - e1 * dot(cy, e1);
-    const double yh = length(yPerp);
-    if (!(yh > 1e-9 * (R + length(cy)))) return 0;  // y on the axis: a ring of paths, measure zero
-    const D3 e2 = yPerp * (1 / yh);
+    D3 e2;
+    double yh;
+    if (!planeAround(e1, cy, 1e-9 * (R + length(cy)), e2, yh)) return 0;  // y on the axis: a ring of paths, measure zero
     // Directions to the outline point at angle a from e1; the visible arc is
     // |a| < acos(R / dx).
     const double aMax = std::acos(R / dx);
@@ -337,24 +367,12 @@ int connectThroughSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, S
     // In the plane, with the centre at the origin: x = (dx, 0), y = (y1, y2).
     const double y1 = dot(cy, e1), y2 = yh, eta = s.ior;
     // h(a): which side of the exit ray y lies (0 on a root), and how far
-    // ahead of the exit point, from the outline point (cos a, sin a) R. The
-    // two refractions in closed form: inside, the angle to the normal is
-    // theta_t at both ends, so the exit's transmitted cosine is cos theta_i.
+    // ahead of the exit point, from the outline point (cos a, sin a) R.
     auto evalCS = [&](double ca, double sa) {
-        ArcEval e;
         PlaneEntry in;
-        if (!enterInPlane(R, dx, eta, ca, sa, in)) return e;
-        const double cosI = in.cosI, cosT = in.cosT, d1x = in.d1x, d1y = in.d1y;
-        const double chord = -2 * R * (ca * d1x + sa * d1y);
-        if (!(chord > 0)) return e;
-        const double p2x = R * ca + d1x * chord, p2y = R * sa + d1y * chord;
-        const double k2 = (eta * cosT - cosI) / R;  // n2 = p2 / R
-        const double d2x = eta * d1x - p2x * k2, d2y = eta * d1y - p2y * k2;
-        const double tx = y1 - p2x, ty = y2 - p2y;
-        e.ok = true;
-        e.h = d2x * ty - d2y * tx;
-        e.ahead = d2x * tx + d2y * ty;
-        return e;
+        PlaneExit out;
+        if (!enterInPlane(R, dx, eta, ca, sa, in) || !exitInPlane(R, eta, ca, sa, in, out)) return ArcEval{};
+        return pointFromRay(out.p2x, out.p2y, out.d2x, out.d2y, y1, y2);
     };
     int n = 0;
     solveOnArc(aMax, thorough, yh < 0.1 * length(cy), evalCS, [&](double root, const ArcEval& r) {
@@ -384,20 +402,18 @@ int connectAcrossSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, Sp
     if (!(dO > R * (1 + 1e-6)) || !(dI < R * (1 - 1e-6))) return 0;
     const D3 e1 = (o - c) * (1 / dO);
     const D3 ci = in - c;
-    const D3 iPerp = ci - e1 * dot(ci, e1);
-    const double ih = length(iPerp);
     // On the axis through o and the centre, the one path is the axis itself
     // (any e2 will do); off it, the plane of o, i and the centre.
-    const bool onAxis = !(ih > 1e-9 * R);
-    const D3 e2 = onAxis ? normalize(cross(e1, std::fabs(e1.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0))) : iPerp * (1 / ih);
+    D3 e2;
+    double ih;
+    const bool onAxis = !planeAround(e1, ci, 1e-9 * R, e2, ih);
     const double aMax = std::acos(R / dO);
     const double i1 = dot(ci, e1), i2 = onAxis ? 0.0 : ih, eta = s.ior;
     // h(a): which side of the refracted ray i lies, from the outline point
     // (cos a, sin a) R, o at (dO, 0).
     auto evalCS = [&](double ca, double sa) {
-        ArcEval e;
         PlaneEntry in;
-        if (!enterInPlane(R, dO, eta, ca, sa, in)) return e;
+        if (!enterInPlane(R, dO, eta, ca, sa, in)) return ArcEval{};
         return pointFromRay(R * ca, R * sa, in.d1x, in.d1y, i1, i2);
     };
     int n = 0;
@@ -427,25 +443,20 @@ int connectThroughSphereToward(const GlassSphere& s, const Vec3& xf, const Vec3&
     if (!(dx > R * (1 + 1e-6))) return 0;
     // The plane of x, the centre and the light's direction.
     const D3 e1 = (x - c) * (1 / dx);
-    const D3 lPerp = L - e1 * dot(L, e1);
-    const double lh = length(lPerp);
-    if (!(lh > 1e-9)) return 0;  // x on the axis through the centre: a ring of paths, measure zero
-    const D3 e2 = lPerp * (1 / lh);
+    D3 e2;
+    double lh;
+    if (!planeAround(e1, L, 1e-9, e2, lh)) return 0;  // x on the axis through the centre: a ring of paths, measure zero
     const double l1 = dot(L, e1), l2 = lh, eta = s.ior;
     const double aMax = std::acos(R / dx);
     // h(a): the sine of the angle from the exit direction to the light's.
     auto evalCS = [&](double ca, double sa) {
         ArcEval e;
         PlaneEntry in;
-        if (!enterInPlane(R, dx, eta, ca, sa, in)) return e;
-        const double chord = -2 * R * (ca * in.d1x + sa * in.d1y);
-        if (!(chord > 0)) return e;
-        const double p2x = R * ca + in.d1x * chord, p2y = R * sa + in.d1y * chord;
-        const double k2 = (eta * in.cosT - in.cosI) / R;
-        const double d2x = eta * in.d1x - p2x * k2, d2y = eta * in.d1y - p2y * k2;
+        PlaneExit out;
+        if (!enterInPlane(R, dx, eta, ca, sa, in) || !exitInPlane(R, eta, ca, sa, in, out)) return e;
         e.ok = true;
-        e.h = d2x * l2 - d2y * l1;
-        e.ahead = d2x * l1 + d2y * l2;
+        e.h = out.d2x * l2 - out.d2y * l1;
+        e.ahead = out.d2x * l1 + out.d2y * l2;
         return e;
     };
     int n = 0;
@@ -470,16 +481,14 @@ int connectAcrossSphereToward(const GlassSphere& s, const Vec3& xf, const Vec3& 
     // point at angle a from the direction towards the light, in the plane
     // of that direction, the centre and x.
     const D3 e1 = L;
-    const D3 xPerp = cx - e1 * dot(cx, e1);
-    const double xh = length(xPerp);
-    const bool onAxis = !(xh > 1e-9 * R);
-    const D3 e2 = onAxis ? normalize(cross(e1, std::fabs(e1.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0))) : xPerp * (1 / xh);
+    D3 e2;
+    double xh;
+    const bool onAxis = !planeAround(e1, cx, 1e-9 * R, e2, xh);
     const double i1 = dot(cx, e1), i2 = onAxis ? 0.0 : xh, eta = s.ior;
     // h(a): which side of the refracted ray x lies; the ray arrives along -e1.
     auto evalCS = [&](double ca, double sa) {
-        ArcEval e;
         const double cosI = ca;
-        if (!(cosI > 0)) return e;
+        if (!(cosI > 0)) return ArcEval{};
         const double cosT = std::sqrt(1 - (1 - cosI * cosI) / (eta * eta));
         const double k1 = cosI / eta - cosT;
         return pointFromRay(R * ca, R * sa, -1 / eta + ca * k1, sa * k1, i1, i2);
@@ -588,80 +597,55 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
     SphereConnection roots[MaxSphereConnections];
     for (const GlassSphere& s : scene.glassSpheres) {
         const bool xInside = lengthSquared(v.p - s.center) < s.radius * s.radius;
-        const bool mediumInside = !scene.regions[size_t(s.inside)].media.empty();
         float cosMax = 1;
         const double pc = xInside ? 0.0 : ballConePdf(s, v.p, &cosMax);
-        // What reaches x from y along the connection cn: transmittance
-        // x -> p1, through the ball's medium (two refractions), p2 -> y.
-        // `farDist`: how far beyond p2 the light is (Infinity: directional),
-        // else |y - p2|.
-        auto throughBall = [&](const SphereConnection& cn, const Vec3& y, float farDist = -1.f) {
+        // What reaches x from the light along the connection cn:
+        // transmittance x -> p1, through the ball's region p1 -> p2 (two
+        // refractions), then p2 to y (the light's own surface ends the
+        // shadow ray), or `farDist` beyond p2 for a light without a point
+        // (Infinity: directional).
+        auto throughBall = [&](const SphereConnection& cn, const Vec3* y, float farDist) {
             const float d1 = length(cn.p1 - origin);
             Color T = shadowTransmittance(ctx, region, origin, cn.wi, d1, rng, estimator);
             if (isBlack(T)) return T;
-            const Vec3 n2 = normalize(cn.p2 - s.center);
-            if (cn.refractions == 1) {
-                // p -> y on the other side (the light's own surface ends the shadow ray).
-                const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
-                return T * shadowTransmittance(ctx, xInside ? s.outside : s.inside, o2, cn.wo,
-                                               farDist >= 0 ? farDist : length(y - o2), rng, estimator);
-            }
-            const Vec3 n1 = normalize(cn.p1 - s.center);
-            const Vec3 d = normalize(cn.p2 - cn.p1);
-            const Ray inside{offsetRayOrigin(scene, cn.p1, n1, d), d};
-            if (mediumInside) {
-                T *= shadowTransmittance(ctx, s.inside, inside.o, d, length(cn.p2 - inside.o), rng, estimator);
+            if (cn.refractions == 2 && !s.emptyInside) {
+                const Vec3 d = normalize(cn.p2 - cn.p1);
+                const Vec3 o1 = offsetRayOrigin(scene, cn.p1, normalize(cn.p1 - s.center), d);
+                T *= shadowTransmittance(ctx, s.inside, o1, d, length(cn.p2 - o1), rng, estimator);
                 if (isBlack(T)) return T;
-            } else if (!s.clearInside) {
-                SurfaceHit h;
-                if (scene.surfaceSet->intersect(inside, 0.f, length(cn.p2 - inside.o) * (1 - 1e-4f), h)) return Color(0);
             }
-            // p2 -> y: the light's own surface ends the shadow ray.
-            const Vec3 o2 = offsetRayOrigin(scene, cn.p2, n2, cn.wo);
-            return T * shadowTransmittance(ctx, s.outside, o2, cn.wo, farDist >= 0 ? farDist : length(y - o2), rng,
-                                           estimator);
+            const int beyond = cn.refractions == 1 && !xInside ? s.inside : s.outside;
+            const Vec3 o2 = offsetRayOrigin(scene, cn.p2, normalize(cn.p2 - s.center), cn.wo);
+            return T * shadowTransmittance(ctx, beyond, o2, cn.wo, y ? length(*y - o2) : farDist, rng, estimator);
         };
         for (const Light& light : scene.lights) {
             const int pattern = connectionPattern(s, light, v.p);
             if (pattern == 0) continue;
-            if (light.isDelta() && !light.isPointLike()) {
-                if (!scene.deltaLightCaustics || !lights.parallelLights) continue;
-                // A light at infinity (directional, or a collimated quad's
-                // beam): every root whose exit direction is the light's,
-                // each f E T (1 - F...) / J.
-                const Vec3 wL = normalize(-light.desc().direction);
-                const int n = pattern == 2 ? connectThroughSphereToward(s, v.p, wL, roots)
-                                           : connectAcrossSphereToward(s, v.p, wL, roots);
-                for (int k = 0; k < n; ++k) {
-                    const SphereConnection& cn = roots[k];
-                    LightSample ls;  // the quad's beam must hold p2
-                    if (!light.sample(cn.p2, 0.f, 0.f, ls)) continue;
-                    const Color f = v.f(cn.wi);
-                    if (isBlack(f) || isBlack(ls.L)) continue;
-                    const Color T = throughBall(cn, cn.p2, ls.dist);
-                    if (isBlack(T)) continue;
-                    L += f * ls.L * T * float(double(cn.transmission) / cn.spreading);
-                }
-                continue;
-            }
-            if (light.isPointLike()) {
-                if (!scene.deltaLightCaustics || !lights.pointLights) continue;
-                // Every root to the light's one point y: f I T (1 - F1)(1 - F2) / G.
+            if (light.isDelta()) {
+                const bool parallel = !light.isPointLike();
+                if (!scene.deltaLightCaustics || !(parallel ? lights.parallelLights : lights.pointLights)) continue;
+                // Every root to a point or spot light's one point y, or
+                // whose exit direction is a directional or collimated
+                // light's: f I T (1 - F...) / G, or f E T (1 - F...) / J.
                 const Vec3 y = light.desc().position;
-                const int n = connect(s, pattern, v.p, y, roots, true);
+                const Vec3 wL = normalize(-light.desc().direction);
+                const int n = !parallel    ? connect(s, pattern, v.p, y, roots, true)
+                              : pattern == 2 ? connectThroughSphereToward(s, v.p, wL, roots)
+                                             : connectAcrossSphereToward(s, v.p, wL, roots);
                 for (int k = 0; k < n; ++k) {
                     const SphereConnection& cn = roots[k];
                     if (!(cn.spreading > 0)) continue;
-                    // The intensity towards p2, the glass's last point (a
-                    // spot's cone and falloff).
+                    // Towards p2, the glass's last point: a spot's cone and
+                    // falloff, a collimated quad's beam.
                     LightSample ls;
                     if (!light.sample(cn.p2, 0.f, 0.f, ls)) continue;
                     const Color f = v.f(cn.wi);
                     if (isBlack(f) || isBlack(ls.L)) continue;
-                    const Color T = throughBall(cn, y);
+                    const Color T = throughBall(cn, parallel ? nullptr : &y, ls.dist);
                     if (isBlack(T)) continue;
-                    const double d2 = double(ls.dist) * double(ls.dist);
-                    L += f * ls.L * T * float(d2 * double(cn.transmission) / cn.spreading);
+                    // The sample's irradiance: I / d^2 from a point, E along a direction.
+                    const double intensityScale = parallel ? 1.0 : double(ls.dist) * double(ls.dist);
+                    L += f * ls.L * T * float(intensityScale * double(cn.transmission) / cn.spreading);
                 }
                 continue;
             }
@@ -682,7 +666,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                 if (!(cosY > 0) || !(cn.spreading > 0)) continue;  // the light's far side
                 const Color f = v.f(cn.wi);
                 if (isBlack(f)) continue;
-                const Color T = throughBall(cn, y);
+                const Color T = throughBall(cn, &y, 0.f);
                 if (isBlack(T)) continue;
                 const double pm = pA * cn.spreading / cosY;  // solid-angle density at x
                 const double pu = lights.pathFollows ? double(v.pdf(cn.wi)) * double(cn.transmission) : 0.0;
@@ -702,7 +686,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             const Color f = v.f(cn.wi);
             if (isBlack(f)) continue;
             const Vec3 yHit = cn.p2 + cn.wo * tLight;
-            const Color T = throughBall(cn, yHit);
+            const Color T = throughBall(cn, &yHit, 0.f);
             if (isBlack(T)) continue;
             const double pm = connectionPdf(s, 2, light, v.p, cn.wi, yHit);
             const double pu = lights.pathFollows ? double(v.pdf(cn.wi)) * double(cn.transmission) : 0.0;

@@ -221,7 +221,7 @@ TEST(SphereCaustics, DeltaLightCausticsOnlyWhereConnectionsFindThemAll) {
 
 TEST(SphereCausticRenders, SomethingInsideTheBallIsSeenByTheConnections) {
     // A diffuse ball inside the glass ball: connections through the glass
-    // must find it in the way (GlassSphere::clearInside false).
+    // must find it in the way (their shadow ray through the ball meets it).
     std::vector<std::string> o = CausticScene;
     o.push_back(R"(surfaces=[{"shape": "sphere", "transform": {"scale": 0.45, "translate": [0, 0.75, 0]},
                               "material": {"type": "dielectric", "ior": 1.5}},
