@@ -31,6 +31,7 @@
 #include <cmath>
 
 #include "estimators/segment_marcher.h"
+#include "transport/light_distance.h"
 #include "transport/roulette.h"
 
 namespace vdbmarch {
@@ -41,10 +42,48 @@ constexpr int MinSamplesDivisor = 4;  // guided: at least ray_samples / 4 per se
 constexpr int MaxSamplesFactor = 8;   // guided: at most 8 ray_samples per segment
 constexpr int ProbeWidth = 32, ProbeHeight = 24;
 
+// Guided: the share of L_i positions drawn towards point, spot and sphere
+// lights near the segment (equiangular sampling, Kulla & Fajardo 2012). Near
+// a light the integrand grows as 1/r^2 over a span far below a cell of the
+// cache, and a cache baked for other lights puts no samples there at all;
+// with this share the weight of a position near a light stays below
+// 1 / (share x equiangular density), whatever the cache says.
+constexpr double LightDistanceShare = 0.25;
+
+// Density at t of the segment's equiangular samplers (prepareLightDistances),
+// each light taken with its odds.
+double lightDistanceDensity(const std::vector<ThreadContext::LightDistance>& lds, float t) {
+    double p = 0;
+    for (const ThreadContext::LightDistance& ld : lds) p += double(ld.choice) * ld.sampler.pdf(t);
+    return p;
+}
+
+// Inverts the same mixture at v in [0, 1): the light by its odds, then its
+// equiangular sampler at the remainder of v.
+float sampleLightDistance(const std::vector<ThreadContext::LightDistance>& lds, double v) {
+    size_t i = 0;
+    for (; i + 1 < lds.size() && v >= double(lds[i].choice); ++i) v -= double(lds[i].choice);
+    return lds[i].sampler.sample(float(std::clamp(v / double(lds[i].choice), 0.0, 1.0 - 1e-7)));
+}
+
+// The step holding t (steps ascend along the ray): its index and the offset.
+bool stepAt(const std::vector<PdfStep>& steps, float t, int& k, float& offset) {
+    auto it = std::upper_bound(steps.begin(), steps.end(), t, [](float v, const PdfStep& s) { return v < s.t0; });
+    if (it == steps.begin()) return false;
+    --it;
+    offset = t - it->t0;
+    if (!(offset >= 0 && offset < it->len)) return false;
+    k = int(it - steps.begin());
+    return true;
+}
+
 class SampledMarcher final : public SegmentMarcher {
 public:
     SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il, bool guided)
-        : SegmentMarcher(scene, std::move(il)), mGuided(guided && mIllumination->cache) {
+        : SegmentMarcher(scene, std::move(il)),
+          mGuided(guided && mIllumination->cache),
+          mLightShare(mGuided && scene.desc.render.volumeSampling != VolumeSampling::Distance ? LightDistanceShare
+                                                                                              : 0.0) {
         if (mGuided) mMeanGuided = measureMeanGuided();
     }
 
@@ -167,12 +206,33 @@ private:
             } else if (pdf.valid()) {
                 // N stratified positions (one uniform per stratum of the CDF).
                 const int n = sampleCount(pdf, beta);
+                // Towards point, spot and sphere lights near the segment the
+                // positions come from the mixture (1 - a) P + a P_light, P_light
+                // the equiangular density (light_distance.h), inverted by the
+                // same stratified uniforms.
+                // The samplers are copied: the L_i paths prepare their own.
+                auto& lights = m.lightDistances;
+                lights.clear();
+                if (mLightShare > 0 && prepareLightDistances(ctx, region, ray, tEnd, -1, false).active)
+                    lights = ctx.lightDistances;
+                const double a = lights.empty() ? 0.0 : mLightShare;
                 MediumPoint ms;
                 for (int j = 0; j < n; ++j) {
                     int k;
                     float offset;
                     double p;
-                    pdf.sample((double(j) + rng.uniformDouble()) / double(n), k, offset, p);
+                    const double u = (double(j) + rng.uniformDouble()) / double(n);
+                    if (u < 1 - a) {
+                        pdf.sample(u / (1 - a), k, offset, p);
+                        if (a > 0) p = (1 - a) * p + a * lightDistanceDensity(lights, steps[size_t(k)].t0 + offset);
+                    } else {
+                        const float t = sampleLightDistance(lights, (u - (1 - a)) / a);
+                        // No step holds t: no scattering there, or the walk
+                        // ended before it (T = 0): nothing to add.
+                        if (!stepAt(steps, t, k, offset)) continue;
+                        p = (1 - a) * pdf.pdf(k, offset) + a * lightDistanceDensity(lights, t);
+                    }
+                    if (!(p > 0)) continue;
                     const PdfStep& s = steps[size_t(k)];
                     const Vec3 x = ray.at(s.t0 + offset);
                     evalMedia(ctx, region, x, ms);  // the phase mixture at x
@@ -193,6 +253,8 @@ private:
     }
 
     const bool mGuided;
+    // The mixture share of the equiangular density (0: the paper's pdf alone).
+    const double mLightShare;
     double mMeanGuided = 0;
 };
 

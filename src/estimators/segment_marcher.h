@@ -30,6 +30,7 @@ struct MarcherScratch final : ThreadContextExtension {
     std::vector<float> stepH;
     MediumPoint walkMedia[WalkBatch];  // the media of the walk's next steps
     RayPdf rayPdf;
+    std::vector<ThreadContext::LightDistance> lightDistances;  // guided: the segment's equiangular samplers
     std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
     // Continuation directions by phase x cached radiance (made on first use).
     std::unique_ptr<RadianceCache::Query> productQuery;

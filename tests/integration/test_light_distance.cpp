@@ -2,12 +2,16 @@
 // tracer: every render.volume_sampling mode against numerical quadrature of
 // single scattering from a point and a spot light inside a homogeneous box,
 // and the three modes against one another on a heterogeneous VDB cloud with
-// multiple scattering, glass, a sphere light and an environment map.
+// multiple scattering, glass, a sphere light and an environment map; and the
+// guided marcher's equiangular share against quadrature, and with caches
+// that know nothing of the light.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "cache/radiance_cache.h"
 #include "core/sampling.h"
+#include "illumination/illumination.h"
 #include "support/support.h"
 
 namespace vdbmarch {
@@ -65,20 +69,24 @@ TEST(LightDistance, SingleScatteringFromPointAndSpotMatchesQuadrature) {
         }
     const double expected[3] = {0.5 * (half[0] + half[1]), half[0], half[1]};
 
-    for (const char* mode : VolumeSamplingModes) {
-        auto scene = sceneFromJson("{" + camera + "," + lights + "," + media + str(R"(,
-            "render": {"method": "reference", "max_depth": 1, "spp": 64, "seed": 5, "volume_sampling": ")",
-                                                                                  mode, "\"}}"));
-        const Image img = renderImage(*scene).image;
-        for (int part = 0; part < 3; ++part) {
-            SampleStats st;
-            for (int y = 0; y < 32; ++y)
-                for (int x = 0; x < 32; ++x)
-                    if (part == 0 || (x < 16) == (part == 1)) st.add(img.rgb(x, y).x);
-            EXPECT_NEAR(st.mean(), expected[part], 4 * st.stdError() + 1e-4 * expected[0])
-                << mode << " part " << part;
+    // The path tracer, and the guided marcher, whose L_i positions mix the
+    // equiangular density into its per-ray pdf unless the mode is "distance".
+    for (const char* method : {"reference", "guided"})
+        for (const char* mode : VolumeSamplingModes) {
+            auto scene = sceneFromJson("{" + camera + "," + lights + "," + media + str(R"(,
+                "photons": {"count": 20000}, "render": {"method": ")", method,
+                                                                      R"(", "max_depth": 1, "spp": 64, "seed": 5,
+                "volume_sampling": ")", mode, "\"}}"));
+            const Image img = renderImage(*scene).image;
+            for (int part = 0; part < 3; ++part) {
+                SampleStats st;
+                for (int y = 0; y < 32; ++y)
+                    for (int x = 0; x < 32; ++x)
+                        if (part == 0 || (x < 16) == (part == 1)) st.add(img.rgb(x, y).x);
+                EXPECT_NEAR(st.mean(), expected[part], 4 * st.stdError() + 1e-4 * expected[0])
+                    << method << " " << mode << " part " << part;
+            }
         }
-    }
 }
 
 // The modes estimate the same image: a VDB cloud (multiple scattering,
@@ -96,6 +104,77 @@ TEST(LightDistance, ModesAgreeOnAHeterogeneousCloudWithGlassAndSky) {
     };
     const Image base = render("distance");
     for (const char* mode : {"equiangular", "mis"}) expectPairedAgreement(base, render(mode), mode);
+}
+
+// Per pixel, the squared difference of two renders (channels averaged).
+SampleStats squaredDifferences(const Image& a, const Image& b) {
+    SampleStats st;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            const Color d = a.rgb(x, y) - b.rgb(x, y);
+            st.add(double(average(d * d)));
+        }
+    return st;
+}
+
+// The guided marcher (the default where media sit in glass or delta lights
+// shine through it) with a cache that knows nothing of the light: a cache
+// baked before the light moved, read with --force. A spot's beam crosses a
+// thin haze in view, its apex outside the view; single scattering. The
+// cache is written to a file and read as `render --cache` reads it, zeroed
+// and moved (cell i given cell n - 1 - i's coefficients). Every render
+// agrees with the path tracer's (paired, 4 standard errors). Per sample, the
+// pair MSE of a wrong cache is at most 2x the path tracer's (the issue's
+// bound; measured 0.95-1.01x, standard error 0.13-0.15), three standard
+// errors included, because a quarter of the positions follow the
+// equiangular density over the beam. The paper's pdf alone
+// (render.volume_sampling = "distance") measured 2.9-4.0x, and must stay
+// above 1x: the scene shows what the share is for.
+TEST(LightDistance, GuidedMarcherWithAWrongCacheKeepsItsNoise) {
+    const std::string json = R"({"camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0],
+        "fov_deg": 40, "resolution": [96, 72]},
+        "lights": [{"type": "spot", "position": [-2.4, 0.1, 0.3], "direction": [1, -0.1, -0.15], "cone_deg": 10,
+                    "falloff_deg": 3, "intensity": 20}],
+        "media": [{"type": "homogeneous", "sigma_a": 0.05, "sigma_s": 0.3, "g": 0.3,
+                   "bounds": {"min": [-3, -1.2, -1], "max": [3, 1.2, 1]}}],
+        "photons": {"count": 40000}, "render": {"method": "@METHOD@", "max_depth": 1, "spp": 32, "seed": @SEED@,
+        "volume_sampling": "@MODE@"}})";
+    auto scene = [&](const std::string& method, const std::string& mode, int seed) {
+        return sceneFromJson(subst(json, {{"METHOD", method}, {"MODE", mode}, {"SEED", str(seed)}}));
+    };
+    TempDir dir("wrongcache");
+    Illumination il = prepareIllumination(*scene("guided", "mis", 1), Method::Guided);
+    ASSERT_TRUE(il.cache);
+    RadianceCache& c = *il.cache;
+    const std::string zeroed = dir.path() + "/zeroed.vdb", moved = dir.path() + "/moved.vdb";
+    const size_t n = c.cells.size(), k = size_t(c.coefficientCount());
+    for (size_t i = 0; i < n / 2; ++i)
+        std::swap_ranges(c.coefficients.begin() + long(i * k), c.coefficients.begin() + long((i + 1) * k),
+                         c.coefficients.begin() + long((n - 1 - i) * k));
+    c.save(moved);
+    std::fill(c.coefficients.begin(), c.coefficients.end(), 0.f);
+    c.save(zeroed);
+
+    auto render = [&](const std::string& cache, const std::string& mode, int seed) {
+        RenderOptions o;
+        o.illumination.cacheFile = cache;
+        return renderImage(*scene("guided", mode, seed), o).image;
+    };
+    const Image truth = renderImage(*scene("reference", "mis", 3)).image;
+    const SampleStats pt =
+        squaredDifferences(renderImage(*scene("reference", "mis", 1)).image, renderImage(*scene("reference", "mis", 2)).image);
+    for (const char* mode : {"mis", "distance"})
+        for (const std::string& cache : {zeroed, moved}) {
+            const Image a = render(cache, mode, 1), b = render(cache, mode, 2);
+            expectPairedAgreement(truth, a, str(mode, " ", cache));
+            const SampleStats st = squaredDifferences(a, b);
+            const double ratio = st.mean() / pt.mean();
+            const double se = ratio * std::hypot(st.stdError() / st.mean(), pt.stdError() / pt.mean());
+            if (std::string(mode) == "mis")
+                EXPECT_LT(ratio + 3 * se, 2.0) << cache;
+            else
+                EXPECT_GT(ratio - 3 * se, 1.0) << cache << ": the scene no longer shows what the share is for";
+        }
 }
 
 }  // namespace
