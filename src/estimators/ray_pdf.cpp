@@ -64,4 +64,52 @@ double RayPdf::pdf(int step, float offset) const {
     return stepProbability(step) * truncatedExponentialPdf(s.kappa, s.len, offset);
 }
 
+namespace {
+
+double lightsDensity(const RayPdf::Lights& lights, float t) {
+    double p = 0;
+    for (const ThreadContext::LightDistance& ld : lights) p += double(ld.choice) * ld.sampler.pdf(t);
+    return p;
+}
+
+}  // namespace
+
+bool RayPdf::locate(float t, int& step, float& offset) const {
+    const std::vector<PdfStep>& steps = *mSteps;
+    auto it = std::upper_bound(steps.begin(), steps.end(), t, [](float v, const PdfStep& s) { return v < s.t0; });
+    if (it == steps.begin()) return false;
+    --it;
+    offset = t - it->t0;
+    if (!(offset >= 0 && offset < it->len)) return false;
+    step = int(it - steps.begin());
+    return true;
+}
+
+double RayPdf::pdfWithLights(int step, float offset, double a, const Lights& lights) const {
+    const double p = pdf(step, offset);
+    if (!(a > 0)) return p;
+    return (1 - a) * p + a * lightsDensity(lights, (*mSteps)[std::size_t(step)].t0 + offset);
+}
+
+bool RayPdf::sampleWithLights(double u, double a, const Lights& lights, int& step, float& offset, double& p) const {
+    if (!(a > 0) || lights.empty()) {
+        sample(u, step, offset, p);
+        return true;
+    }
+    if (u < 1 - a) {
+        sample(u / (1 - a), step, offset, p);
+    } else {
+        // The light by its odds, then its sampler at the rest of u.
+        double v = (u - (1 - a)) / a;
+        std::size_t i = 0;
+        for (; i + 1 < lights.size() && v >= double(lights[i].choice); ++i) v -= double(lights[i].choice);
+        const float c = lights[i].choice;
+        if (!(c > 0)) return false;
+        const float t = lights[i].sampler.sample(float(std::clamp(v / double(c), 0.0, 1.0 - 1e-7)));
+        if (!locate(t, step, offset)) return false;
+    }
+    p = pdfWithLights(step, offset, a, lights);
+    return p > 0;
+}
+
 }  // namespace vdbmarch

@@ -17,6 +17,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "transport/thread_context.h"
+
 namespace vdbmarch {
 
 struct PdfStep {
@@ -46,6 +48,20 @@ public:
     double pdf(int step, float offset) const;
     // Probability of `step` (the histogram bin).
     double stepProbability(int step) const { return mCdf[std::size_t(step) + 1] - mCdf[std::size_t(step)]; }
+
+    // Towards lights near the segment (the guided marcher): the mixture
+    //   P'(t) = (1 - a) P(t) + a sum_l c_l p_l(t),
+    // p_l the equiangular densities of `lights` (prepareLightDistances) and
+    // c_l their odds, inverted at u: [0, 1 - a) draws from P, [1 - a, 1)
+    // picks a light by its odds and draws from it. False when the light's t
+    // lies in no step (nothing scatters there, or the walk ended before it):
+    // that sample adds nothing.
+    using Lights = std::vector<ThreadContext::LightDistance>;
+    bool sampleWithLights(double u, double a, const Lights& lights, int& step, float& offset, double& pdf) const;
+    // P'(t) at `offset` from the start of `step`.
+    double pdfWithLights(int step, float offset, double a, const Lights& lights) const;
+    // The step holding t, and t's offset in it.
+    bool locate(float t, int& step, float& offset) const;
 
 private:
     const std::vector<PdfStep>* mSteps = nullptr;

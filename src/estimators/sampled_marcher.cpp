@@ -50,33 +50,6 @@ constexpr int ProbeWidth = 32, ProbeHeight = 24;
 // 1 / (share x equiangular density), whatever the cache says.
 constexpr double LightDistanceShare = 0.25;
 
-// Density at t of the segment's equiangular samplers (prepareLightDistances),
-// each light taken with its odds.
-double lightDistanceDensity(const std::vector<ThreadContext::LightDistance>& lds, float t) {
-    double p = 0;
-    for (const ThreadContext::LightDistance& ld : lds) p += double(ld.choice) * ld.sampler.pdf(t);
-    return p;
-}
-
-// Inverts the same mixture at v in [0, 1): the light by its odds, then its
-// equiangular sampler at the remainder of v.
-float sampleLightDistance(const std::vector<ThreadContext::LightDistance>& lds, double v) {
-    size_t i = 0;
-    for (; i + 1 < lds.size() && v >= double(lds[i].choice); ++i) v -= double(lds[i].choice);
-    return lds[i].sampler.sample(float(std::clamp(v / double(lds[i].choice), 0.0, 1.0 - 1e-7)));
-}
-
-// The step holding t (steps ascend along the ray): its index and the offset.
-bool stepAt(const std::vector<PdfStep>& steps, float t, int& k, float& offset) {
-    auto it = std::upper_bound(steps.begin(), steps.end(), t, [](float v, const PdfStep& s) { return v < s.t0; });
-    if (it == steps.begin()) return false;
-    --it;
-    offset = t - it->t0;
-    if (!(offset >= 0 && offset < it->len)) return false;
-    k = int(it - steps.begin());
-    return true;
-}
-
 class SampledMarcher final : public SegmentMarcher {
 public:
     SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il, bool guided)
@@ -221,18 +194,8 @@ private:
                     int k;
                     float offset;
                     double p;
-                    const double u = (double(j) + rng.uniformDouble()) / double(n);
-                    if (u < 1 - a) {
-                        pdf.sample(u / (1 - a), k, offset, p);
-                        if (a > 0) p = (1 - a) * p + a * lightDistanceDensity(lights, steps[size_t(k)].t0 + offset);
-                    } else {
-                        const float t = sampleLightDistance(lights, (u - (1 - a)) / a);
-                        // No step holds t: no scattering there, or the walk
-                        // ended before it (T = 0): nothing to add.
-                        if (!stepAt(steps, t, k, offset)) continue;
-                        p = (1 - a) * pdf.pdf(k, offset) + a * lightDistanceDensity(lights, t);
-                    }
-                    if (!(p > 0)) continue;
+                    if (!pdf.sampleWithLights((double(j) + rng.uniformDouble()) / double(n), a, lights, k, offset, p))
+                        continue;
                     const PdfStep& s = steps[size_t(k)];
                     const Vec3 x = ray.at(s.t0 + offset);
                     evalMedia(ctx, region, x, ms);  // the phase mixture at x

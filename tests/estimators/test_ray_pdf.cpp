@@ -1,7 +1,9 @@
 // The per-ray pdf of the transmittance and guided marchers (eqs. 9, 16-18):
 // normalisation, chi-square of its samples, and the guided estimator's
 // expectation against quadrature of the same integrand along a ray, for a
-// good histogram, a negative-ringing (clamped) one and an empty one.
+// good histogram, a negative-ringing (clamped) one and an empty one; and the
+// mixture with equiangular densities towards lights (the guided marcher's
+// share towards lights near the ray): chi-square and expectation.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include "core/rng.h"
+#include "core/sampling.h"
 #include "estimators/ray_pdf.h"
 #include "support/support.h"
 
@@ -164,6 +167,100 @@ TEST(RayPdf, GuidedEstimatorIsUnbiasedForAnyHistogram) {
             EXPECT_LT(s.variance, 0.1 * transmittance.variance) << "a good histogram must pay off";
         }
     }
+}
+
+// Two lights near the synthetic ray: one 0.02 from it at t = 0.63 (L_i's
+// sharp peak), one 0.3 from it at t = 2.9 whose equiangular interval runs
+// past the ray's last step (3.0) to 3.5, so a share of its draws lands in no
+// step; odds 0.7 and 0.3.
+RayPdf::Lights syntheticLights() {
+    RayPdf::Lights lights(2);
+    lights[0].light = 0;
+    lights[0].sampler = EquiangularSampler(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.63f, 0.02f, 0), 0.f, 3.f, 1e-6f);
+    lights[0].choice = 0.7f;
+    lights[1].light = 1;
+    lights[1].sampler = EquiangularSampler(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2.9f, 0, 0.3f), 0.f, 3.5f, 1e-6f);
+    lights[1].choice = 0.3f;
+    return lights;
+}
+
+TEST(RayPdf, MixtureWithLightsMatchesItsSamples) {
+    SyntheticRay r;
+    const RayPdf::Lights lights = syntheticLights();
+    const double a = 0.25;
+    std::vector<float> wrong;  // the cache's light only where L_i is dark
+    for (const auto& s : r.steps) wrong.push_back(s.t0 >= 2.2f && s.t0 < 2.5f ? 10.f : 0.f);
+    RayPdf pdf;
+    pdf.build(r.steps, wrong.data());
+    // Expected counts: 8 sub-bins per step by Simpson quadrature of the
+    // mixture density, and one bin for the light draws that land past the
+    // last step (the second light's density over [3, 3.5), times a c_2).
+    const int sub = 8, samples = 400000, n = 200;
+    auto simpson = [&](double lo, double hi, auto&& f) {
+        double sum = 0;
+        for (int i = 0; i <= n; ++i) sum += ((i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2)) * f(lo + i * (hi - lo) / n);
+        return sum * (hi - lo) / n / 3;
+    };
+    std::vector<double> observed(r.steps.size() * sub + 1, 0), expected(r.steps.size() * sub + 1, 0);
+    double total = 0;
+    for (size_t b = 0; b + 1 < expected.size(); ++b) {
+        const PdfStep& s = r.steps[b / sub];
+        const double lo = s.len * double(b % sub) / sub, hi = s.len * double(b % sub + 1) / sub;
+        expected[b] = simpson(lo, hi, [&](double x) { return pdf.pdfWithLights(int(b / sub), float(x), a, lights); });
+        total += expected[b];
+    }
+    expected.back() = a * lights[1].choice * simpson(3.0, 3.5, [&](double t) { return lights[1].sampler.pdf(float(t)); });
+    total += expected.back();
+    EXPECT_NEAR(total, 1.0, 1e-4) << "the mixture's mass over the steps and past them";
+    for (double& e : expected) e *= samples;
+    Rng rng(11);
+    for (int i = 0; i < samples; ++i) {
+        int k;
+        float x;
+        double p;
+        if (!pdf.sampleWithLights(rng.uniformDouble(), a, lights, k, x, p)) {
+            observed.back() += 1;
+            continue;
+        }
+        ASSERT_GE(x, 0.f);
+        ASSERT_LT(x, r.steps[size_t(k)].len);
+        ASSERT_NEAR(p, pdf.pdfWithLights(k, x, a, lights), 1e-9 * p);
+        observed[size_t(k) * sub + size_t(std::min(sub - 1, int(x / r.steps[size_t(k)].len * sub)))] += 1;
+    }
+    test::ChiSquare c = pooledChiSquare(observed, expected, 20);
+    EXPECT_GT(c.p(), 1e-4) << "chi2 " << c.chi2 << " dof " << c.dof;
+}
+
+// Eq. 18 over the mixture, N stratified positions: the expectation of the
+// integral for the wrong histogram, and a variance far below that of the
+// wrong histogram alone (the light at t = 0.63 is L_i's sharp peak).
+TEST(RayPdf, MixtureWithLightsIsUnbiasedAndRescuesAWrongHistogram) {
+    SyntheticRay r;
+    const double truth = quadrature(r);
+    const RayPdf::Lights lights = syntheticLights();
+    std::vector<float> wrong;
+    for (const auto& s : r.steps) wrong.push_back(s.t0 >= 2.2f && s.t0 < 2.5f ? 10.f : 0.f);
+    RayPdf pdf;
+    pdf.build(r.steps, wrong.data());
+    const int n = 4, repeats = 20000;
+    SampleStats with, without;
+    Rng rng(12);
+    for (int rep = 0; rep < repeats; ++rep) {
+        double e[2] = {0, 0};
+        for (int m = 0; m < 2; ++m)
+            for (int j = 0; j < n; ++j) {
+                int k;
+                float x;
+                double p;
+                if (!pdf.sampleWithLights((j + rng.uniformDouble()) / n, m == 0 ? 0.25 : 0.0, lights, k, x, p)) continue;
+                e[m] += r.weight(k, x) * syntheticLi(r.steps[size_t(k)].t0 + x) / (n * p);
+            }
+        with.add(e[0]);
+        without.add(e[1]);
+    }
+    EXPECT_NEAR(with.mean(), truth, 4 * with.stdError());
+    EXPECT_NEAR(without.mean(), truth, 4 * without.stdError());
+    EXPECT_LT(with.variance(), 0.25 * without.variance());
 }
 
 }  // namespace
