@@ -179,11 +179,10 @@ private:
             } else if (pdf.valid()) {
                 // N stratified positions (one uniform per stratum of the CDF).
                 const int n = sampleCount(pdf, beta);
-                // Towards point, spot and sphere lights near the segment the
-                // positions come from the mixture (1 - a) P + a P_light, P_light
-                // the equiangular density (light_distance.h), inverted by the
-                // same stratified uniforms.
-                // The samplers are copied: the L_i paths prepare their own.
+                // Towards point, spot and sphere lights near the segment, the
+                // mixture with their equiangular densities (RayPdf::
+                // sampleWithLights). The samplers are copied: the L_i paths
+                // prepare their own in the same ThreadContext.
                 auto& lights = m.lightDistances;
                 lights.clear();
                 if (mLightShare > 0 && prepareLightDistances(ctx, region, ray, tEnd, -1, false).active)
