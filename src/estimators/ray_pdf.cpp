@@ -96,18 +96,19 @@ bool RayPdf::sampleWithLights(double u, double a, const Lights& lights, int& ste
         sample(u, step, offset, p);
         return true;
     }
-    if (u < 1 - a) {
+    if (u < 1 - a) {  // P drew it, and gave its density
         sample(u / (1 - a), step, offset, p);
-    } else {
-        // The light by its odds, then its sampler at the rest of u.
-        double v = (u - (1 - a)) / a;
-        std::size_t i = 0;
-        for (; i + 1 < lights.size() && v >= double(lights[i].choice); ++i) v -= double(lights[i].choice);
-        const float c = lights[i].choice;
-        if (!(c > 0)) return false;
-        const float t = lights[i].sampler.sample(float(std::clamp(v / double(c), 0.0, 1.0 - 1e-7)));
-        if (!locate(t, step, offset)) return false;
+        p = (1 - a) * p + a * lightsDensity(lights, (*mSteps)[std::size_t(step)].t0 + offset);
+        return p > 0;
     }
+    // A light by its odds, then its sampler at the rest of u.
+    double v = (u - (1 - a)) / a;
+    std::size_t i = 0;
+    for (; i + 1 < lights.size() && v >= double(lights[i].choice); ++i) v -= double(lights[i].choice);
+    const float c = lights[i].choice;
+    if (!(c > 0)) return false;
+    const float t = lights[i].sampler.sample(float(std::clamp(v / double(c), 0.0, 1.0 - 1e-7)));
+    if (!locate(t, step, offset)) return false;
     p = pdfWithLights(step, offset, a, lights);
     return p > 0;
 }

@@ -140,6 +140,15 @@ SphereConnection toConnection(const D3& w, const Traced& tr, double G, int refra
     return c;
 }
 
+// The one-refraction path from x towards the point of the sphere's outline
+// at angle `a` in the plane (e1, e2) through its centre: the direction w
+// and the path traced across the surface.
+bool traceFromOutline(const GlassSphere& s, const D3& x, const D3& e1, const D3& e2, double a, D3& w, Traced& tr) {
+    const D3 p = D3(s.center) + (e1 * std::cos(a) + e2 * std::sin(a)) * double(s.radius);
+    w = normalize(p - x);
+    return traceAcross(s, x, w, tr);
+}
+
 // The glass sphere a sphere light can be reached through: outside it, or
 // (one refraction) inside it.
 bool lightOutside(const GlassSphere& s, const Light& l) {
@@ -419,12 +428,10 @@ int connectAcrossSphere(const GlassSphere& s, const Vec3& xf, const Vec3& yf, Sp
     int n = 0;
     auto keep = [&](double root, const ArcEval& r) {
         if (!(n < MaxSphereConnections && r.ok && r.ahead > 0)) return;
-        const D3 p = c + (e1 * std::cos(root) + e2 * std::sin(root)) * R;
-        // The path from x: its direction, traced across the surface, must
-        // pass through y.
-        const D3 w = normalize(p - x);
+        // The path from x, traced across the surface, must pass through y.
+        D3 w;
         Traced tr;
-        if (!traceAcross(s, x, w, tr)) return;
+        if (!traceFromOutline(s, x, e1, e2, root, w, tr)) return;
         const D3 toY = y - tr.p2;
         if (!(dot(toY, tr.wo) > 0) || !(length(cross(tr.wo, toY)) < 1e-6 * length(toY))) return;
         const double G = spreading(traceAcross, s, x, w, &y, tr);
@@ -496,10 +503,11 @@ int connectAcrossSphereToward(const GlassSphere& s, const Vec3& xf, const Vec3& 
     int n = 0;
     auto keep = [&](double root, const ArcEval& r) {
         if (!(n < MaxSphereConnections && r.ok && r.ahead > 0)) return;
-        const D3 p = c + (e1 * std::cos(root) + e2 * std::sin(root)) * R;
-        const D3 w = normalize(p - x);
+        D3 w;
         Traced tr;
-        if (!traceAcross(s, x, w, tr) || !(dot(tr.wo, L) > 0) || !(length(cross(tr.wo, L)) < 1e-6)) return;
+        if (!traceFromOutline(s, x, e1, e2, root, w, tr) || !(dot(tr.wo, L) > 0) ||
+            !(length(cross(tr.wo, L)) < 1e-6))
+            return;
         const double J = spreading(traceAcross, s, x, w, nullptr, tr);
         if (J > 0) out[n++] = toConnection(w, tr, J, 1);
     };
