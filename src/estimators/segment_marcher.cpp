@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "transport/direct_light.h"
+#include "transport/glass_splitting.h"
 #include "transport/path_tracer.h"
 #include "transport/roulette.h"
 #include "transport/sphere_caustics.h"
@@ -38,42 +39,73 @@ PathRadiance SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadCont
 // second, a surface's next-event estimate at the first bounce, and what
 // inScattered() counts as direct at a march sample before the first bounce.
 PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
-    const Scene& scene = mScene;
     ++ctx.counters.cameraRays;
-    Color L(0), beta(1);
-    Ray ray = cameraRay;
-    int region = regionAtRayStart(scene, ray);
-    // After a diffuse bounce, lights and the background were already counted
-    // by the surface's shadow rays, unless glass bent the path since.
-    bool lightsCounted = false;
-    int diffuseBounces = 0;
-    for (int bounce = 0;; ++bounce) {
+    CameraPath path;
+    path.region = regionAtRayStart(mScene, cameraRay);
+    return traceFrom(cameraRay, path, rng, ctx);
+}
+
+PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, ThreadContext& ctx) const {
+    const Scene& scene = mScene;
+    Color L(0);
+    Color& beta = path.beta;
+    int& region = path.region;
+    // The background seen in glass reflections that were counted whole
+    // (mirroredLight): part of what the camera sees through.
+    float mirroredThrough = 0;
+    auto done = [&](float transmittance) { return PathRadiance{L, transmittance + mirroredThrough, Color(0)}; };
+    for (;; ++path.bounce) {
         const RaySegment seg = nextRaySegment(scene, ray);
         const SurfaceHit& h = seg.surface;
         const bool hit = seg.hitSurface;
         const int light = seg.light;
         const float segEnd = seg.tEnd;
-        scratch(ctx).pathDepth = diffuseBounces;
-        if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return {L, 0.f, Color(0)};
+        scratch(ctx).pathDepth = path.diffuseBounces;
+        if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return done(0.f);
         auto addSeen = [&](const Color& Le) {
             L += Le;
-            if (mTallyDirect && diffuseBounces <= 1) scratch(ctx).direct += Le;
+            if (mTallyDirect && path.diffuseBounces <= 1) scratch(ctx).direct += Le;
         };
+        const bool seen = !path.lightsCounted && !path.mirrorCounted;
         if (light >= 0) {
-            if (!lightsCounted) addSeen(beta * scene.lights[size_t(light)].emittedRadiance());
-            return {L, 0.f, Color(0)};
+            if (seen) addSeen(beta * scene.lights[size_t(light)].emittedRadiance());
+            return done(0.f);
         }
         if (!hit) {
             // The camera path seen straight (or through glass): the map as a backdrop.
-            if (!lightsCounted)
-                addSeen(beta * (diffuseBounces == 0 ? scene.environment.radianceSeen(ray.d)
-                                                     : scene.environment.radiance(ray.d)));
-            return {L, diffuseBounces > 0 ? 0.f : average(beta), Color(0)};  // a diffuse surface is opaque
+            if (seen)
+                addSeen(beta * (path.diffuseBounces == 0 ? scene.environment.radianceSeen(ray.d)
+                                                          : scene.environment.radiance(ray.d)));
+            return done(path.diffuseBounces > 0 ? 0.f : average(beta));  // a diffuse surface is opaque
         }
         ++ctx.counters.surfaceHits;
-        if (bounce >= scene.desc.render.maxSurfaceBounces) return {L, 0.f, Color(0)};
+        if (path.bounce >= scene.desc.render.maxSurfaceBounces) return done(0.f);
         const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
-        const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
+        // Glass may split the camera path, or count the light its
+        // reflection sees (glass_splitting.h).
+        const bool split = path.diffuseBounces == 0 && path.glassSplits < SplitDielectricEvents;
+        const PathSurfaceEvent pe = pathSurfaceEvent(ctx, h, ray.d, region, u, split, path.diffuseBounces == 0, rng);
+        addSeen(beta * pe.light);
+        if (path.diffuseBounces == 0) mirroredThrough += average(beta) * pe.backgroundSeen;
+        path.mirrorCounted = pe.mirrorCounted;
+        const SurfaceEvent& e = pe.event;
+        const Color& weight = pe.weight;
+        if (pe.split) {
+            // Both outcomes: the reflection, then the refraction.
+            ++path.glassSplits;
+            CameraPath reflected = path;
+            reflected.beta = beta * pe.mirrorWeight;
+            reflected.region = pe.mirror.region;
+            reflected.lightsCounted = false;
+            ++reflected.bounce;
+            const PathRadiance r = traceFrom(pe.mirror.ray, reflected, rng, ctx);
+            beta *= weight;
+            if (!e.straight) path.lightsCounted = false;
+            ++path.bounce;
+            region = e.region;
+            const PathRadiance t = traceFrom(e.ray, path, rng, ctx);
+            return {L + r.L + t.L, mirroredThrough + r.transmittance + t.transmittance, Color(0)};
+        }
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
             const ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
@@ -82,23 +114,23 @@ PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext
             // lights, which no path finds; sphere lights too where max_depth
             // ends the path here, else the path below finds them.
             if (sceneHasSphereCaustics(scene)) {
-                const bool last = diffuseBounces + 1 >= scene.desc.render.maxDepth;
+                const bool last = path.diffuseBounces + 1 >= scene.desc.render.maxDepth;
                 Ld += beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching,
                                                 {last, true, !last});
             }
             L += Ld;
-            if (mTallyDirect && diffuseBounces == 0) scratch(ctx).direct += Ld;
+            if (mTallyDirect && path.diffuseBounces == 0) scratch(ctx).direct += Ld;
             // Light that reaches the surface after scattering in a medium
             // (what shadow rays miss): continue the path in the cosine-
             // sampled direction, marching the media it crosses, as a
             // scattering event of max_depth; lights were counted above.
-            if (++diffuseBounces >= scene.desc.render.maxDepth) return {L, 0.f, Color(0)};
-            beta *= e.weight;
-            if (!russianRoulette(beta, rng)) return {L, 0.f, Color(0)};
-            lightsCounted = true;
+            if (++path.diffuseBounces >= scene.desc.render.maxDepth) return done(0.f);
+            beta *= weight;
+            if (!russianRoulette(beta, rng)) return done(0.f);
+            path.lightsCounted = true;
         } else {
-            beta *= e.weight;
-            if (!e.straight) lightsCounted = false;  // shadow rays cannot follow a reflected or bent path
+            beta *= weight;
+            if (!e.straight) path.lightsCounted = false;  // shadow rays cannot follow a reflected or bent path
         }
         ray = e.ray;
         region = e.region;

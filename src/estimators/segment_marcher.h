@@ -73,7 +73,22 @@ public:
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
 
 private:
+    // Where a camera path stands in the loop of traceFrom.
+    struct CameraPath {
+        Color beta{1, 1, 1};
+        int region = 0;
+        int bounce = 0;           // surfaces met
+        int diffuseBounces = 0;
+        int glassSplits = 0;      // glass events whose two outcomes it follows (SplitDielectricEvents)
+        // After a diffuse bounce, lights and the background were already
+        // counted by the surface's shadow rays, unless glass bent the path since.
+        bool lightsCounted = false;
+        // The light or background the last glass reflection's ray meets was
+        // counted at the glass (mirroredLight).
+        bool mirrorCounted = false;
+    };
     PathRadiance trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const;
+    PathRadiance traceFrom(Ray ray, CameraPath path, Rng& rng, ThreadContext& ctx) const;
 
 protected:
     // Marches [0, tEnd) of the ray in `region`, adding to L and attenuating

@@ -119,6 +119,10 @@ struct RenderSettings {
     // Medium vertices of the path tracer draw a share of their directions
     // towards spot lights' beams (transport/beam_directions.h).
     bool beamDirections = true;
+    // Camera paths follow both outcomes of their first glass event, and
+    // every other glass event counts the light its reflection sees
+    // (transport/surface_event.h, SplitDielectricEvents; mirroredLight).
+    bool glassSplitting = true;
     // Noise target (render --noise): > 0 stops the render once the
     // estimated RMSE over the image's mean is below it, sampling only the
     // blocks of pixels still above it (adaptive sampling, docs/noise.md).

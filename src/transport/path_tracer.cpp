@@ -6,6 +6,7 @@
 #include "core/sampling.h"
 #include "transport/beam_directions.h"
 #include "transport/direct_light.h"
+#include "transport/glass_splitting.h"
 #include "transport/light_distance.h"
 #include "transport/media_point.h"
 #include "transport/path_guide.h"
@@ -53,6 +54,7 @@ void startVertex(PathState& st, const Vec3& x, const Vec3& wi, float pdf, bool c
     st.causticsAtLast = caustics;
     st.lensSphere = -1;
     st.lensRefractions = 0;
+    st.mirrorCounted = false;
 }
 
 // Russian roulette on the throughput after RouletteMinDepth events.
@@ -66,6 +68,15 @@ bool roulette(Color& beta, const PathState& st, Rng& rng) {
 void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf) {
     const float pf = v.fPdf(wi);
     if (pf > 0 && pdf > 0) st.rouletteScale = std::min(st.rouletteScale * (pdf / pf), 1e20f);
+}
+
+// The state after a reflection or refraction at surface `surface`.
+void followSurfaceEvent(const Scene& scene, const SurfaceEvent& e, int surface, PathState& st) {
+    if (e.straight) return;
+    st.specular = true;  // next-event estimation cannot see through this
+    // Refractions at one glass sphere keep the pattern of a sphere caustic
+    // connection; anything else breaks it.
+    followLensPattern(scene, e.kind == SurfaceEvent::Kind::Refract, surface, st.lensSphere, st.lensRefractions);
 }
 
 }  // namespace
@@ -92,7 +103,6 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         if (events <= 1) direct += c;
     };
     auto result = [&](float transmittance) { return PathRadiance{L, transmittance, direct}; };
-    int surfaceBounces = 0;
     MediumPoint mp;
     // Copies split from the path at a segment's collision: traced once the
     // free flight's walk has returned (their own walks reuse the thread
@@ -270,7 +280,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 w = sphereCausticPathWeight(scene, st.lensSphere, st.lensRefractions, light, st.lastPoint, st.lastDir,
                                             st.lastPdf, ray.at(tEnd));
             }
-            add(beta * l.emittedRadiance() * w, st.depth);
+            if (!st.mirrorCounted) add(beta * l.emittedRadiance() * w, st.depth);
             return result(0.f);
         }
         if (!hit) {
@@ -279,14 +289,31 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const Environment& env = scene.environment;
             const float w = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(ray.d)) : 1.f;
             // A camera path that never scattered sees the map as a backdrop.
-            add(beta * (st.depth == 0 ? env.radianceSeen(ray.d) : env.radiance(ray.d)) * w, st.depth);
-            return result(st.depth == startDepth && surfaceBounces == 0 ? average(beta) : 0.f);
+            if (!st.mirrorCounted)
+                add(beta * (st.depth == 0 ? env.radianceSeen(ray.d) : env.radiance(ray.d)) * w, st.depth);
+            return result(st.depth == startDepth && st.surfaceBounces == 0 ? average(beta) : 0.f);
         }
         ++ctx.counters.surfaceHits;
-        if (++surfaceBounces > scene.desc.render.maxSurfaceBounces) return result(0.f);
+        if (++st.surfaceBounces > scene.desc.render.maxSurfaceBounces) return result(0.f);
         const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
-        const SurfaceEvent e = sampleSurfaceEvent(scene, h, ray.d, region, u, TransportMode::Radiance);
-        Color weight = e.weight;
+        // Glass may split a camera path, or count the light its reflection
+        // sees (glass_splitting.h).
+        const bool split = st.depth == 0 && st.glassSplits < SplitDielectricEvents;
+        const PathSurfaceEvent pe = pathSurfaceEvent(ctx, h, ray.d, region, u, split, st.depth == 0, rng);
+        add(beta * pe.light, st.depth);
+        st.mirrorCounted = pe.mirrorCounted;
+        if (pe.split) {
+            ++st.glassSplits;
+            PathState sr = st;
+            followSurfaceEvent(scene, pe.mirror, h.surface, sr);
+            const Color br = beta * pe.mirrorWeight;
+            sr.rouletteScale = std::min(sr.rouletteScale * average(br), 1e20f);
+            const PathRadiance pr = tracePath(ctx, pe.mirror.ray, pe.mirror.region, channel, rng, sr);
+            L += br * pr.L;
+            direct += br * pr.direct;
+        }
+        const SurfaceEvent& e = pe.event;
+        Color weight = pe.weight;
         Ray next = e.ray;
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             if (++st.depth > maxDepth) return result(0.f);
@@ -305,12 +332,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 scaleRoulette(st, vertex, next.d, pdf);
             }
             startVertex(st, h.p, next.d, pdf, caustics);
-        } else if (!e.straight) {
-            st.specular = true;  // next-event estimation cannot see through this
-            // Refractions at one glass sphere keep the pattern of a sphere
-            // caustic connection; anything else breaks it.
-            followLensPattern(scene, e.kind == SurfaceEvent::Kind::Refract, h.surface, st.lensSphere,
-                              st.lensRefractions);
+        } else {
+            followSurfaceEvent(scene, e, h.surface, st);
         }
         beta *= weight;
         ray = next;

@@ -63,6 +63,14 @@ struct PathState {
     Vec3 lastDir{0, 0, 1};  // the direction sampled at lastPoint
     int lensSphere = -1;
     int lensRefractions = 0;
+    // Surfaces met (render.max_surface_bounces), and glass events whose two
+    // outcomes the path followed both (SplitDielectricEvents).
+    int surfaceBounces = 0;
+    int glassSplits = 0;
+    // The light or background the last glass reflection's ray meets first
+    // was counted at the glass (mirroredLight in path_tracer.cpp): the path
+    // that took that reflection must not count it again.
+    bool mirrorCounted = false;
 };
 
 // What a path brings back: a camera path's result (Estimator::radiance) and a

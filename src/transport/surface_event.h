@@ -32,6 +32,27 @@ SurfaceEvent sampleSurfaceEvent(const Scene& scene, const SurfaceHit& hit, const
                                 TransportMode mode);
 
 
+// The two outcomes of a smooth dielectric (glass) event and the chance of
+// the first: reflection with probability F (Fresnel), else refraction (or
+// the reflection the geometric normal gives where the shading normal bends
+// a refraction to the wrong side). sampleSurfaceEvent picks one by u[0];
+// a camera path may follow both instead, weighted F and 1 - F
+// (SplitDielectricEvents), which is the same expectation.
+struct DielectricEvents {
+    SurfaceEvent outcome[2];  // [0] with probability reflectProbability, [1] otherwise
+    float reflectProbability = 0;
+};
+DielectricEvents dielectricEvents(const Scene& scene, const SurfaceHit& hit, const Vec3& d, int region,
+                                  TransportMode mode);
+
+// Camera paths follow both outcomes of their first this many glass events
+// before any scattering event. A small light mirrored in glass is a
+// highlight a thousand times the surroundings' brightness that a Fresnel
+// choice of a few percent finds in a few of a pixel's samples: the noise of
+// that count was most of fig4_caustic_sphere's error (BENCHMARKS.md,
+// "Glass highlights").
+constexpr int SplitDielectricEvents = 1;
+
 // Offset origin for a ray leaving a surface at p in direction d.
 Vec3 offsetRayOrigin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& d);
 

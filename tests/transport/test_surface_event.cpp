@@ -171,6 +171,42 @@ TEST(SurfaceEvent, OutgoingDirectionIsAlwaysOnTheGeometricSide) {
     EXPECT_GT(redone, 0);  // the fallback was exercised
 }
 
+TEST(SurfaceEvent, BothGlassOutcomesAreTheEventsTheFresnelChoicePicks) {
+    // dielectricEvents gives the two events sampleSurfaceEvent chooses
+    // between, bit for bit, and the chance of the first: a path that follows
+    // both, weighted by their chances, has the choice's expectation. With
+    // tilted shading normals, so that the geometric-normal fallback is in.
+    auto s = eventScene(glass(1.5f));
+    Rng rng(17);
+    int splits = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 ng = sampleUniformSphere(rng.uniform(), rng.uniform());
+        const Vec3 ns = normalize(ng + sampleUniformSphere(rng.uniform(), rng.uniform()) * 0.5f);
+        const SurfaceHit h = hitAt(ng, ns);
+        const Vec3 d = sampleUniformSphere(rng.uniform(), rng.uniform());
+        if (std::fabs(dot(d, ng)) < 1e-3f) continue;
+        const int region = dot(d, ng) < 0 ? Outside : Inside;
+        for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) {
+            const DielectricEvents both = dielectricEvents(*s, h, d, region, mode);
+            const float F = both.reflectProbability;
+            ASSERT_GE(F, 0.f);
+            ASSERT_LE(F, 1.f);
+            EXPECT_EQ(both.outcome[0].kind, SurfaceEvent::Kind::Reflect);
+            const float u[3] = {rng.uniform(), 0.3f, 0.6f};
+            const SurfaceEvent e = sampleSurfaceEvent(*s, h, d, region, u, mode);
+            const SurfaceEvent& pick = both.outcome[u[0] < F ? 0 : 1];
+            EXPECT_EQ(e.kind, pick.kind);
+            EXPECT_EQ(e.region, pick.region);
+            EXPECT_EQ(e.ray.o, pick.ray.o);
+            EXPECT_EQ(e.ray.d, pick.ray.d);
+            EXPECT_EQ(e.weight, pick.weight);
+            EXPECT_EQ(e.straight, pick.straight);
+            splits += F > 0 && F < 1;
+        }
+    }
+    EXPECT_GT(splits, 20000);  // of 40000: the rest reflect totally from inside
+}
+
 TEST(SurfaceEvent, PhotonsTakeTheAdjointShadingNormalCorrection) {
     auto s = eventScene(glass(1.5f));
     const Vec3 ns = normalize(Vec3(0.25f, 0.1f, 1));
