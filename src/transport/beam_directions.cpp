@@ -162,13 +162,17 @@ inline double angleAt(double y, double x) {
 // angle (tabulated per region). The axial density is piecewise constant on
 // BeamBins bins, each bin's mass from G at its ends, so that a direction's
 // density keeps a closed form per bin (inverseSquareMoment).
+static_assert(BeamMixture::Sight::Edges == BeamBins + 1, "a sight holds G at every bin edge");
+
 struct BeamView {
     const ThreadContext::Beam* beam = nullptr;
     const std::vector<float>* G = nullptr;
     BeamMixture::Sight sight;
+    // The vertex's stored sight, whose edge integrals are kept (or null).
+    BeamMixture::Sight* stored = nullptr;
 
-    BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, const BeamMixture::Sight& s)
-        : beam(&b), G(&table), sight(s) {}
+    BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, BeamMixture::Sight& s)
+        : beam(&b), G(&table), sight(s), stored(&s) {}
     BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, const Vec3& x) : beam(&b), G(&table) {
         const Vec3 v = x - b.apex;
         sight.sx = double(dot(v, b.axis));
@@ -186,10 +190,16 @@ struct BeamView {
     }
     // G at bin edge i, linear between the table's angles.
     double angleIntegralAt(int i) const {
+        if (stored && (stored->known >> i & 1u)) return stored->edgeIntegral[i];
         const double f = std::clamp(angleAt(sight.h, sight.sx - edge(i)) / PiD, 0.0, 1.0) * BeamAngleSteps;
         const int k = std::min(int(f), BeamAngleSteps - 1);
         const std::vector<float>& t = *G;
-        return double(t[size_t(k)]) + (f - k) * double(t[size_t(k + 1)] - t[size_t(k)]);
+        const double g = double(t[size_t(k)]) + (f - k) * double(t[size_t(k + 1)] - t[size_t(k)]);
+        if (stored) {
+            stored->edgeIntegral[i] = g;
+            stored->known |= 1u << i;
+        }
+        return g;
     }
 };
 
@@ -201,7 +211,13 @@ BeamView viewOf(const BeamMixture& m, size_t k) {
         double total = 0;
         for (size_t j = 0; j < r.beams.size(); ++j) {
             const BeamView v(r.beams[j], *r.angleIntegral, m.vertex->p);
-            if (j < size_t(BeamMixture::MaxSights)) m.mSights[j] = v.sight;
+            if (j < size_t(BeamMixture::MaxSights)) {
+                BeamMixture::Sight& stored = m.mSights[j];
+                stored = v.sight;
+                stored.edgeIntegral[0] = v.sight.g0;
+                stored.edgeIntegral[BeamBins] = v.sight.g1;
+                stored.known = 1u | 1u << BeamBins;
+            }
             total += v.weight();
         }
         m.mBeamWeight = total;

@@ -59,6 +59,12 @@ struct BeamMixture {
     // beam's ends, and the beam's weight), computed once per vertex.
     struct Sight {
         double sx = 0, h = 1, g0 = 0, g1 = 0, weight = 0;
+        // The angle integral at the axial bins' edges, made as they are
+        // first asked for (bit i of `known`): a vertex's sampling and its
+        // pdfs (next-event MIS, the sampled direction) ask for the same ones.
+        static constexpr int Edges = 17;
+        double edgeIntegral[Edges];
+        unsigned known = 0;
     };
     static constexpr int MaxSights = 4;
     mutable Sight mSights[MaxSights];
