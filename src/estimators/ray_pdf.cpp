@@ -85,32 +85,64 @@ bool RayPdf::locate(float t, int& step, float& offset) const {
     return true;
 }
 
-double RayPdf::pdfWithLights(int step, float offset, double a, const Lights& lights) const {
-    const double p = pdf(step, offset);
-    if (!(a > 0)) return p;
-    return (1 - a) * p + a * lightsDensity(lights, (*mSteps)[std::size_t(step)].t0 + offset);
-}
-
-bool RayPdf::sampleWithLights(double u, double a, const Lights& lights, int& step, float& offset, double& p) const {
-    if (!(a > 0) || lights.empty()) {
+bool RayPdf::sampleMixture(double u, const Mixture& mix, int& step, float& offset, double& p, float& t) const {
+    const double a = mix.lights && !mix.lights->empty() ? mix.lightShare : 0.0;
+    const double b = mix.folds && !mix.folds->empty() ? mix.foldShare : 0.0;
+    if (!(a > 0) && !(b > 0)) {
         sample(u, step, offset, p);
+        t = (*mSteps)[std::size_t(step)].t0 + offset;
         return true;
     }
-    if (u < 1 - a) {  // P drew it, and gave its density
-        sample(u / (1 - a), step, offset, p);
-        p = (1 - a) * p + a * lightsDensity(lights, (*mSteps)[std::size_t(step)].t0 + offset);
+    if (u < 1 - a - b) {  // P drew it, and gave its density
+        sample(u / (1 - a - b), step, offset, p);
+        t = (*mSteps)[std::size_t(step)].t0 + offset;
+        if (b > 0 && !stepOffCrossing(*mix.folds, t, step, offset)) return false;
+        p = mixturePdf(step, offset, mix, t);
         return p > 0;
     }
-    // A light by its odds, then its sampler at the rest of u.
-    double v = (u - (1 - a)) / a;
-    std::size_t i = 0;
-    for (; i + 1 < lights.size() && v >= double(lights[i].choice); ++i) v -= double(lights[i].choice);
-    const float c = lights[i].choice;
-    if (!(c > 0)) return false;
-    const float t = lights[i].sampler.sample(float(std::clamp(v / double(c), 0.0, 1.0 - 1e-7)));
-    if (!locate(t, step, offset)) return false;
-    p = pdfWithLights(step, offset, a, lights);
+    if (u < 1 - b) {  // a light by its odds, then its sampler at the rest of u
+        const Lights& lights = *mix.lights;
+        double v = (u - (1 - a - b)) / a;
+        std::size_t i = 0;
+        for (; i + 1 < lights.size() && v >= double(lights[i].choice); ++i) v -= double(lights[i].choice);
+        const float c = lights[i].choice;
+        if (!(c > 0)) return false;
+        if (!locate(lights[i].sampler.sample(float(std::clamp(v / double(c), 0.0, 1.0 - 1e-7))), step, offset))
+            return false;
+        t = (*mSteps)[std::size_t(step)].t0 + offset;
+        if (b > 0 && !stepOffCrossing(*mix.folds, t, step, offset)) return false;
+    } else {
+        // The folds' t as drawn: t0 + offset may round it off a crossing,
+        // where their density is sharpest.
+        t = mix.folds->sample(float(std::clamp((u - (1 - b)) / b, 0.0, 1.0 - 1e-7)));
+        if (!locate(t, step, offset)) return false;
+    }
+    p = mixturePdf(step, offset, mix, t);
     return p > 0;
+}
+
+bool RayPdf::stepOffCrossing(const FoldSampler& folds, float& t, int& step, float& offset) const {
+    // A draw exactly on a fold's crossing (the folds' density is 0 there:
+    // FoldSampler::sample) moves to the next float: the light at that one
+    // float point is bounded only by its distance to the fold, which can be
+    // far below a float step.
+    for (int i = 0; i < folds.count(); ++i)
+        if (t == folds.crossing(i)) {
+            t = std::nextafter(t, Infinity);
+            return locate(t, step, offset);
+        }
+    return true;
+}
+
+double RayPdf::mixturePdf(int step, float offset, const Mixture& mix, float t) const {
+    const double a = mix.lights && !mix.lights->empty() ? mix.lightShare : 0.0;
+    const double b = mix.folds && !mix.folds->empty() ? mix.foldShare : 0.0;
+    double p = pdf(step, offset);
+    if (!(a > 0) && !(b > 0)) return p;
+    p *= 1 - a - b;
+    if (a > 0) p += a * lightsDensity(*mix.lights, t);
+    if (b > 0) p += b * mix.folds->pdf(t);
+    return p;
 }
 
 }  // namespace vdbmarch

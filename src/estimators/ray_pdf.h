@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "transport/caustic_folds.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
@@ -49,21 +50,43 @@ public:
     // Probability of `step` (the histogram bin).
     double stepProbability(int step) const { return mCdf[std::size_t(step) + 1] - mCdf[std::size_t(step)]; }
 
-    // Towards lights near the segment (the guided marcher): the mixture
-    //   P'(t) = (1 - a) P(t) + a sum_l c_l p_l(t),
-    // p_l the equiangular densities of `lights` (prepareLightDistances) and
-    // c_l their odds, inverted at u: [0, 1 - a) draws from P, [1 - a, 1)
-    // picks a light by its odds and draws from it. False when the light's t
-    // lies in no step (nothing scatters there, or the walk ended before it):
-    // that sample adds nothing.
+    // Towards lights near the segment (the guided marcher), and towards the
+    // folds of caustics behind glass spheres that it crosses: the mixture
+    //   P'(t) = (1 - a - b) P(t) + a sum_l c_l p_l(t) + b p_f(t),
+    // p_l the equiangular densities of `lights` (prepareLightDistances), c_l
+    // their odds, p_f the folds' density (caustic_folds.h), inverted at u:
+    // [0, 1 - a - b) draws from P, then a light by its odds and its sampler,
+    // then the folds. False when the drawn t lies in no step (nothing
+    // scatters there, or the walk ended before it): that sample adds nothing.
     using Lights = std::vector<ThreadContext::LightDistance>;
-    bool sampleWithLights(double u, double a, const Lights& lights, int& step, float& offset, double& pdf) const;
-    // P'(t) at `offset` from the start of `step`.
-    double pdfWithLights(int step, float offset, double a, const Lights& lights) const;
+    struct Mixture {
+        double lightShare = 0;
+        const Lights* lights = nullptr;
+        double foldShare = 0;
+        const FoldSampler* folds = nullptr;
+    };
+    // t: the position along the ray, t0 + offset of the step, except for a
+    // fold's draw, which keeps the t it drew (its density is sharpest there).
+    bool sampleMixture(double u, const Mixture& mix, int& step, float& offset, double& pdf, float& t) const;
+    // P'(t) at t, `offset` from the start of `step`.
+    double mixturePdf(int step, float offset, const Mixture& mix, float t) const;
+    double mixturePdf(int step, float offset, const Mixture& mix) const {
+        return mixturePdf(step, offset, mix, (*mSteps)[std::size_t(step)].t0 + offset);
+    }
+    // The mixture with lights alone (b = 0).
+    bool sampleWithLights(double u, double a, const Lights& lights, int& step, float& offset, double& pdf) const {
+        float t;
+        return sampleMixture(u, {a, &lights}, step, offset, pdf, t);
+    }
+    double pdfWithLights(int step, float offset, double a, const Lights& lights) const {
+        return mixturePdf(step, offset, {a, &lights});
+    }
     // The step holding t, and t's offset in it.
     bool locate(float t, int& step, float& offset) const;
 
 private:
+    bool stepOffCrossing(const FoldSampler& folds, float& t, int& step, float& offset) const;
+
     const std::vector<PdfStep>* mSteps = nullptr;
     std::vector<double> mCdf;  // size steps + 1, mCdf[0] = 0, last = 1
     double mBase = 0, mGuided = 0;

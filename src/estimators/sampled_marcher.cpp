@@ -50,6 +50,12 @@ constexpr int ProbeWidth = 32, ProbeHeight = 24;
 // 1 / (share x equiangular density), whatever the cache says.
 constexpr double LightDistanceShare = 0.25;
 
+// Guided: the share of L_i positions drawn near the segment's crossings of
+// the folds of point and parallel lights' caustics behind glass spheres
+// (caustic_folds.h), where the light grows as 1 / sqrt(distance): with it a
+// position's weight there stays below 1 / (share x the folds' density).
+constexpr double FoldDistanceShare = 0.15;
+
 class SampledMarcher final : public SegmentMarcher {
 public:
     SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il, bool guided)
@@ -188,15 +194,17 @@ private:
                 if (mLightShare > 0 && prepareLightDistances(ctx, region, ray, tEnd, -1, false).active)
                     lights = ctx.lightDistances;
                 const double a = lights.empty() ? 0.0 : mLightShare;
+                FoldSampler& folds = m.foldDistances;
+                const bool crossesFolds = mLightShare > 0 && prepareFoldDistances(ctx, region, ray, tEnd, folds);
+                const RayPdf::Mixture mixture{a, &lights, crossesFolds ? FoldDistanceShare : 0.0, &folds};
                 MediumPoint ms;
                 for (int j = 0; j < n; ++j) {
                     int k;
-                    float offset;
+                    float offset, t;
                     double p;
-                    if (!pdf.sampleWithLights((double(j) + rng.uniformDouble()) / double(n), a, lights, k, offset, p))
+                    if (!pdf.sampleMixture((double(j) + rng.uniformDouble()) / double(n), mixture, k, offset, p, t))
                         continue;
-                    const PdfStep& s = steps[size_t(k)];
-                    const Vec3 x = ray.at(s.t0 + offset);
+                    const Vec3 x = ray.at(t);
                     evalMedia(ctx, region, x, ms);  // the phase mixture at x
                     const Color Li = inScattered(ctx, region, x, ray.d, ms, rng);
                     if (isBlack(Li)) continue;

@@ -31,6 +31,7 @@ struct MarcherScratch final : ThreadContextExtension {
     MediumPoint walkMedia[WalkBatch];  // the media of the walk's next steps
     RayPdf rayPdf;
     std::vector<ThreadContext::LightDistance> lightDistances;  // guided: the segment's equiangular samplers
+    FoldSampler foldDistances;  // guided: the segment's crossings of caustic folds
     std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
     // Continuation directions by phase x cached radiance (made on first use).
     std::unique_ptr<RadianceCache::Query> productQuery;

@@ -45,6 +45,23 @@ struct GlassSphere {
     bool emptyInside = true;  // no medium, other surface or sphere light inside: rays cross it unhindered
 };
 
+// The fold of the caustic that a glass sphere focuses from a point-like or
+// parallel light outside it (the pattern of two refractions): where
+// neighbouring exit rays meet, so two of the connections to the light merge
+// and their spreading goes to 0 (transport/caustic_folds.h). The light's
+// rays through the ball are symmetric about the axis through the light (or
+// along a parallel light's direction) and the centre, so the fold is a
+// surface of revolution: the envelope of the exit rays in one plane through
+// the axis, a polyline of (z, rho) points, z along `axis` (the light's
+// travel) from `center`, rho the distance from the axis, each the meeting
+// point of the exit rays about the light's ray of parameter u (an angle off
+// the axis from a point light, a height for a parallel one).
+struct CausticFold {
+    Vec3 center, axis;
+    std::vector<float> z, rho;
+    std::vector<double> u;  // the parameter of the light's ray whose exit rays meet there
+};
+
 // True when a straight shadow ray crosses the surface (interfaces and
 // index-matched glass); every other surface blocks it.
 bool crossedByShadowRays(const MaterialDesc& material);

@@ -6,6 +6,7 @@
 #include "transport/direct_light.h"
 #include "transport/path_tracer.h"
 #include "transport/roulette.h"
+#include "transport/sphere_caustics.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
 #include "transport/transmittance.h"
@@ -42,12 +43,16 @@ float trackingDensity(ThreadContext& ctx, const LightDistanceSegment& seg, float
     return trackedOrAverage(mp.sigma_s, seg.channel) * std::exp(-tau);
 }
 
-// The power heuristic between the equiangular density and the tracking one.
+// The power heuristic between a distance sampler's density and the tracking one.
+float distanceWeight(float pdfDistance, float pdfTracking) {
+    if (!(pdfDistance > 0)) return 0.f;
+    const double a = double(pdfDistance) * pdfDistance, b = double(pdfTracking) * pdfTracking;
+    return float(a / (a + b));
+}
 float equiangularWeight(const LightDistanceSegment& seg, float pdfEquiangular, float pdfTracking) {
     if (!(pdfEquiangular > 0)) return 0.f;
     if (seg.equiangularOnly) return 1.f;
-    const double a = double(pdfEquiangular) * pdfEquiangular, b = double(pdfTracking) * pdfTracking;
-    return float(a / (a + b));
+    return distanceWeight(pdfEquiangular, pdfTracking);
 }
 
 // Per region the hull of its scattering media's bounds, and per (region,
@@ -121,6 +126,7 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     const Scene& scene = ctx.scene;
     const VolumeSampling mode = scene.desc.render.volumeSampling;
     LightDistanceSegment seg{ray, region, channel, mode == VolumeSampling::Equiangular};
+    seg.tEnd = tEnd;
     if (!regionHasLightDistances(ctx, region, skipPointLights)) return seg;
     const size_t nLights = scene.lights.size();
     const char* candidate = ctx.lightDistanceCandidate.data() + size_t(region) * nLights;
@@ -172,6 +178,32 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
     return seg;
 }
 
+namespace {
+
+// The light `estimate(vertex, mp)` scattered at t towards the segment's
+// origin, drawn with density `pdf` and weighed against the tracking
+// collisions by the power heuristic (`onlyDistance`: all of it here):
+// T(t) sigma_s(t) L w / pdf.
+template <typename Estimate>
+Color scatteredAt(ThreadContext& ctx, const LightDistanceSegment& seg, float t, float pdf, bool onlyDistance, Rng& rng,
+                  Estimate&& estimate) {
+    if (!(pdf > 0)) return Color(0);
+    const Vec3 x = seg.ray.at(t);
+    MediumPoint mp;
+    evalMedia(ctx, seg.region, x, mp);
+    if (!mp.scatters()) return Color(0);
+    const float pTrack = trackingDensity(ctx, seg, t, mp);
+    float w = onlyDistance ? 1.f : distanceWeight(pdf, pTrack);
+    if (!(w > 0) || !russianRoulette(w, rng, MisWeightRouletteThreshold)) return Color(0);
+    // Light that ends here: the quiet unbiased estimator (transmittance.h).
+    const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng, TransmittanceEstimator::UnbiasedMarching);
+    if (isBlack(T)) return Color(0);
+    const Color L = estimate(ScatterVertex::inMedium(x, seg.ray.d, mp.phase));
+    return T * mp.sigma_s * L * (w / pdf);
+}
+
+}  // namespace
+
 Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng) {
     const std::vector<ThreadContext::LightDistance>& samplers = ctx.lightDistances;
     if (samplers.empty()) return Color(0);
@@ -184,24 +216,31 @@ Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, 
     }
     const ThreadContext::LightDistance& ld = samplers[k];
     const float t = ld.sampler.sample(rng.uniform());
-    const float pdf = ld.choice * ld.sampler.pdf(t);
-    if (!(pdf > 0)) return Color(0);
-    const Vec3 x = seg.ray.at(t);
-    MediumPoint mp;
-    evalMedia(ctx, seg.region, x, mp);
-    if (!mp.scatters()) return Color(0);
-    float w = equiangularWeight(seg, pdf, trackingDensity(ctx, seg, t, mp));
-    if (!(w > 0) || !russianRoulette(w, rng, MisWeightRouletteThreshold)) return Color(0);
-    // Light that ends here: the quiet unbiased estimator (transmittance.h).
-    const Color T = regionTransmittance(ctx, seg.region, seg.ray, t, rng, TransmittanceEstimator::UnbiasedMarching);
-    if (isBlack(T)) return Color(0);
-    DirectLightOptions o;
-    o.transmittance = TransmittanceEstimator::UnbiasedMarching;
-    o.misWithPathHits = true;  // a sphere light is also found by the phase-sampled path
-    o.sampleBackground = false;
-    o.onlyLight = ld.light;
-    const Color nee = directLight(ctx, seg.region, ScatterVertex::inMedium(x, seg.ray.d, mp.phase), rng, o);
-    return T * mp.sigma_s * nee * (w / pdf);
+    return scatteredAt(ctx, seg, t, ld.choice * ld.sampler.pdf(t), seg.equiangularOnly, rng, [&](const ScatterVertex& v) {
+        DirectLightOptions o;
+        o.transmittance = TransmittanceEstimator::UnbiasedMarching;
+        o.misWithPathHits = true;  // a sphere light is also found by the phase-sampled path
+        o.sampleBackground = false;
+        o.onlyLight = ld.light;
+        return directLight(ctx, seg.region, v, rng, o);
+    });
+}
+
+Color sampleFoldDistances(ThreadContext& ctx, const LightDistanceSegment& seg, const FoldSampler& folds, bool pointLights,
+                          Rng& rng) {
+    if (folds.empty()) return Color(0);
+    const float t = folds.sample(rng.uniform());
+    if (!(t > 0 && t < seg.tEnd)) return Color(0);
+    return scatteredAt(ctx, seg, t, float(folds.pdf(t)), false, rng, [&](const ScatterVertex& v) {
+        return sphereCausticLight(ctx, seg.region, v, rng, TransmittanceEstimator::UnbiasedMarching,
+                                  {false, pointLights, false, true});
+    });
+}
+
+float foldTrackingWeight(ThreadContext& ctx, const LightDistanceSegment& seg, const FoldSampler& folds, float t,
+                         const MediumPoint& mp) {
+    if (folds.empty()) return 1.f;
+    return 1 - distanceWeight(float(folds.pdf(t)), trackingDensity(ctx, seg, t, mp));
 }
 
 const float* trackingWeights(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp) {

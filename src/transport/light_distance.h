@@ -22,6 +22,7 @@
 #pragma once
 
 #include "core/rng.h"
+#include "transport/caustic_folds.h"
 #include "transport/media_point.h"
 #include "transport/path_guide.h"
 
@@ -37,6 +38,7 @@ struct LightDistanceSegment {
     // of a light's single scattering where they can land (no MIS).
     bool equiangularOnly = false;
     bool active = false;  // some light has a sampler
+    float tEnd = 0;
     // The segment's free flight is the guide's (prepared): the collision
     // density in the weights is then its flightDensity.
     const PathGuide* guide = nullptr;
@@ -61,6 +63,19 @@ bool lightReach(ThreadContext& ctx, int light, const Ray& ray, float& t0, float&
 // T(t) sigma_s(t) f L T_shadow w / pdf(t), the light's single scattering
 // along the segment weighted for MIS.
 Color sampleLightDistances(ThreadContext& ctx, const LightDistanceSegment& seg, Rng& rng);
+
+// Near the folds of caustics behind glass spheres (caustic_folds.h), where
+// the light of point-like and parallel lights connected through the glass
+// grows as 1 / sqrt(distance): one distance sample by the folds' density
+// (crossings of the segment, prepareFoldDistances), estimating those
+// connections there (sphereCausticLight's delta part; point-like lights
+// only with `pointLights`, as the vertices connect them), weighed against
+// the tracking collisions' by the power heuristic. foldTrackingWeight is
+// the collisions' share at t (CausticLights::deltaWeight).
+Color sampleFoldDistances(ThreadContext& ctx, const LightDistanceSegment& seg, const FoldSampler& folds, bool pointLights,
+                          Rng& rng);
+float foldTrackingWeight(ThreadContext& ctx, const LightDistanceSegment& seg, const FoldSampler& folds, float t,
+                         const MediumPoint& mp);
 
 // Per scene light, the weight of next-event estimation at a tracking
 // collision at t (media mp there): 1 for lights without a sampler. Written to

@@ -116,11 +116,14 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     // Next-event estimation at a vertex of the path, and the connections to
     // sphere lights through glass spheres (sphere_caustics.h); true when
     // those were made (the path's own hits through a ball weigh against them).
-    auto nextEvent = [&](const ScatterVertex& vertex, const float* lightWeights) {
+    // `deltaWeight`: the share of the point-like and parallel lights'
+    // connections left to the vertex by the distance sample near caustic
+    // folds (light_distance.h).
+    auto nextEvent = [&](const ScatterVertex& vertex, const float* lightWeights, float deltaWeight) {
         add(beta * directLight(ctx, region, vertex, rng, nextEventOptions(st, lightWeights)), st.depth);
         if (!sceneHasSphereCaustics(scene)) return false;
         add(beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching,
-                                              {true, !st.pointLightsByPhotons, true}),
+                                              {true, !st.pointLightsByPhotons, true, true, deltaWeight}),
             st.depth);
         return true;
     };
@@ -158,6 +161,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             st.windowReference = float(double(average(beta)) * I);
         }
         if (lightDistances.active) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
+        // And near the folds of caustics behind glass spheres that the
+        // segment crosses, where connected light grows as 1 / sqrt(distance).
+        FoldSampler folds;
+        if (st.depth < maxDepth && prepareFoldDistances(ctx, region, ray, tEnd, folds))
+            add(beta * sampleFoldDistances(ctx, lightDistances, folds, !st.pointLightsByPhotons, rng), st.depth + 1);
 
         int numCopies = 0;  // of `copies`, split at this segment's collision
         bool windowed = false;  // roulette was decided by the weight window
@@ -176,7 +184,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             BeamMixture beams{&ctx, region, &vertex};
             const bool beamDirections = !guidedDirection && beams.attach(vertex, st.pointLightsByPhotons);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
-            const bool caustics = nextEvent(vertex, weights);
+            const float deltaWeight = folds.empty() ? 1.f : foldTrackingWeight(ctx, lightDistances, folds, t, mp);
+            const bool caustics = nextEvent(vertex, weights, deltaWeight);
             // Guided roulette and splitting of what follows the vertex.
             int paths = 1;
             if (st.windowReference > 0) {
@@ -322,7 +331,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             // A share of the directions towards spot beams (beam_directions.h).
             BeamMixture beams{&ctx, region, &vertex};
             const bool beamDirections = beams.attach(vertex, st.pointLightsByPhotons);
-            const bool caustics = nextEvent(vertex, nullptr);
+            const bool caustics = nextEvent(vertex, nullptr, 1.f);
             float pdf = e.pdf;
             if (beamDirections) {
                 weight = Color(1);

@@ -118,6 +118,9 @@ struct CausticLights {
     bool pointLights = true;     // where Scene::deltaLightCaustics holds
     bool pathFollows = true;
     bool parallelLights = true;  // directional and collimated, where Scene::deltaLightCaustics holds
+    // The share of the point-like and parallel lights' connections left to
+    // this vertex by distance sampling near caustic folds (light_distance.h).
+    float deltaWeight = 1;
 };
 
 // The caustic light at vertex v (in `region`) through every glass sphere:
@@ -151,6 +154,15 @@ inline void followLensPattern(const Scene& scene, bool refraction, int surface, 
         ++refractions;
     }
 }
+
+// The fold (scene.h's CausticFold) of light `light` through sphere s,
+// traced through the ball in double precision (the envelope by central differences along the family
+// of the light's rays); false when the light is not point-like or parallel,
+// or lies inside or on the ball.
+bool causticFold(const GlassSphere& s, const Light& light, CausticFold& out);
+// The fold's exact point (z, rho) for the light's ray of parameter u;
+// false where there is none.
+bool causticFoldPoint(const GlassSphere& s, const Light& light, double u, double& z, double& rho);
 
 // True when sphere caustic connections apply (render.sphere_caustics, a
 // sphere light or Scene::deltaLightCaustics, a glass sphere): every vertex

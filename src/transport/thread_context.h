@@ -71,6 +71,18 @@ struct ThreadContext {
         const std::vector<float>* angleIntegral = nullptr;
     };
     std::vector<BeamRegion> beamRegions;
+    // Made on first use by caustic_folds.cpp: the folds of the caustics of
+    // point-like and parallel lights through glass spheres (shared by all
+    // threads), with a bounding sphere and the half-width of the density
+    // drawn around a crossing.
+    struct FoldSurface {
+        int sphere = -1, light = -1;
+        std::shared_ptr<const CausticFold> fold;
+        Vec3 boundCenter;
+        float boundRadius = 0, halfWidth = 0;
+    };
+    std::vector<FoldSurface> foldSurfaces;
+    bool foldSurfacesMade = false;
     RenderCounters counters;
     std::unique_ptr<ThreadContextExtension> extension;
 

@@ -169,6 +169,15 @@ TEST(RayPdf, GuidedEstimatorIsUnbiasedForAnyHistogram) {
     }
 }
 
+// Simpson's rule on 200 intervals of [lo, hi].
+template <typename F>
+double simpson(double lo, double hi, F&& f) {
+    const int n = 200;
+    double sum = 0;
+    for (int i = 0; i <= n; ++i) sum += ((i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2)) * f(lo + i * (hi - lo) / n);
+    return sum * (hi - lo) / n / 3;
+}
+
 // Two lights near the synthetic ray: one 0.02 from it at t = 0.63 (L_i's
 // sharp peak), one 0.3 from it at t = 2.9 whose equiangular interval runs
 // past the ray's last step (3.0) to 3.5, so a share of its draws lands in no
@@ -195,12 +204,7 @@ TEST(RayPdf, MixtureWithLightsMatchesItsSamples) {
     // Expected counts: 8 sub-bins per step by Simpson quadrature of the
     // mixture density, and one bin for the light draws that land past the
     // last step (the second light's density over [3, 3.5), times a c_2).
-    const int sub = 8, samples = 400000, n = 200;
-    auto simpson = [&](double lo, double hi, auto&& f) {
-        double sum = 0;
-        for (int i = 0; i <= n; ++i) sum += ((i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2)) * f(lo + i * (hi - lo) / n);
-        return sum * (hi - lo) / n / 3;
-    };
+    const int sub = 8, samples = 400000;
     std::vector<double> observed(r.steps.size() * sub + 1, 0), expected(r.steps.size() * sub + 1, 0);
     double total = 0;
     for (size_t b = 0; b + 1 < expected.size(); ++b) {
@@ -225,6 +229,68 @@ TEST(RayPdf, MixtureWithLightsMatchesItsSamples) {
         ASSERT_GE(x, 0.f);
         ASSERT_LT(x, r.steps[size_t(k)].len);
         ASSERT_NEAR(p, pdf.pdfWithLights(k, x, a, lights), 1e-9 * p);
+        observed[size_t(k) * sub + size_t(std::min(sub - 1, int(x / r.steps[size_t(k)].len * sub)))] += 1;
+    }
+    test::ChiSquare c = pooledChiSquare(observed, expected, 20);
+    EXPECT_GT(c.p(), 1e-4) << "chi2 " << c.chi2 << " dof " << c.dof;
+}
+
+// The mixture with the folds of caustics behind glass spheres too
+// (caustic_folds.h): a crossing at t = 1.4 (half-width 0.1) and one at 2.95
+// (half-width 0.2, so part of its draws lands past the last step). The
+// folds' density is singular at a crossing, so its share of each bin comes
+// from its closed-form CDF, the rest by Simpson quadrature.
+TEST(RayPdf, MixtureWithLightsAndFoldsMatchesItsSamples) {
+    SyntheticRay r;
+    const RayPdf::Lights lights = syntheticLights();
+    FoldSampler folds;
+    const double tf[2] = {1.4, 2.95}, w[2] = {0.1, 0.2};
+    for (int i = 0; i < 2; ++i) folds.add(float(tf[i]), float(w[i]));
+    const RayPdf::Mixture mix{0.25, &lights, 0.15, &folds};
+    RayPdf pdf;
+    std::vector<float> h;
+    for (const auto& s : r.steps) h.push_back(1.f + s.t0);
+    pdf.build(r.steps, h.data());
+    auto foldMass = [&](double lo, double hi) {  // a window's CDF on a side: sqrt(d / w) / 2
+        double m = 0;
+        for (int i = 0; i < 2; ++i) {
+            auto cdf = [&](double t) {
+                const double x = std::clamp((t - tf[i]) / w[i], -1.0, 1.0);
+                return 0.5 + std::copysign(0.5 * std::sqrt(std::fabs(x)), x);
+            };
+            m += 0.5 * (cdf(hi) - cdf(lo));
+        }
+        return m;
+    };
+    const int sub = 8, samples = 400000;
+    std::vector<double> observed(r.steps.size() * sub + 1, 0), expected(r.steps.size() * sub + 1, 0);
+    double total = 0;
+    for (size_t b = 0; b + 1 < expected.size(); ++b) {
+        const int k = int(b / sub);
+        const PdfStep& s = r.steps[size_t(k)];
+        const double lo = s.len * double(b % sub) / sub, hi = s.len * double(b % sub + 1) / sub;
+        expected[b] = simpson(lo, hi, [&](double x) {
+                          return (1 - 0.25 - 0.15) * pdf.pdf(k, float(x)) + 0.25 * pdf.pdfWithLights(k, float(x), 1.0, lights);
+                      }) +
+                      0.15 * foldMass(s.t0 + lo, s.t0 + hi);
+        total += expected[b];
+    }
+    expected.back() = 0.25 * lights[1].choice * simpson(3.0, 3.5, [&](double t) { return lights[1].sampler.pdf(float(t)); }) +
+                      0.15 * foldMass(3.0, 3.5);
+    total += expected.back();
+    EXPECT_NEAR(total, 1.0, 1e-4) << "the mixture's mass over the steps and past them";
+    for (double& e : expected) e *= samples;
+    Rng rng(13);
+    for (int i = 0; i < samples; ++i) {
+        int k;
+        float x, t;
+        double p;
+        if (!pdf.sampleMixture(rng.uniformDouble(), mix, k, x, p, t)) {
+            observed.back() += 1;
+            continue;
+        }
+        ASSERT_NEAR(t, r.steps[size_t(k)].t0 + x, 1e-6f);
+        ASSERT_NEAR(p, pdf.mixturePdf(k, x, mix, t), 1e-9 * p);
         observed[size_t(k) * sub + size_t(std::min(sub - 1, int(x / r.steps[size_t(k)].len * sub)))] += 1;
     }
     test::ChiSquare c = pooledChiSquare(observed, expected, 20);

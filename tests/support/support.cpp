@@ -526,4 +526,12 @@ std::string methodParamName(const ::testing::TestParamInfo<Method>& info) { retu
 
 std::string methodOverride(Method m) { return str("render.method=\"", methodName(m), "\""); }
 
+GlassSphere figure4Ball() {
+    GlassSphere s;
+    s.center = Vec3(0.f, 0.75f, 0.f);
+    s.radius = 0.45f;
+    s.ior = 1.5f;
+    return s;
+}
+
 }  // namespace vdbmarch::test

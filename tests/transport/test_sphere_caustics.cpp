@@ -11,18 +11,13 @@
 
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "support/support.h"
 #include "transport/sphere_caustics.h"
 
 namespace vdbmarch {
 namespace {
 
-GlassSphere ball() {
-    GlassSphere s;
-    s.center = Vec3(0.f, 0.75f, 0.f);
-    s.radius = 0.45f;
-    s.ior = 1.5f;
-    return s;
-}
+GlassSphere ball() { return test::figure4Ball(); }
 
 // Distance from y to the exit ray of the connection.
 double missDistance(const SphereConnection& c, const Vec3& y) {
