@@ -705,6 +705,62 @@ void featureRowDistance(const std::vector<Feature>& features, int y, int dx, int
     }
 }
 
+// ---------------------------------------------------------------------------
+// The alpha-regression candidate: per pixel p, a weighted least-squares fit
+// of the half's values over the search window to a line in
+// alpha'(q) - alpha'(p), alpha' the other half's alpha (so the fit's
+// feature is independent of the values fitted, as in cross-filtering),
+// with the NL-means weights; its value at p is the intercept. In a volume
+// the colour follows alpha (1 - transmittance: how much medium the pixel
+// sees) closely, and alpha is smooth and nearly noise-free, so where the
+// weights take in neighbours of more or less medium (the rim of a cloud, a
+// thin strand), the line carries their values over to p's alpha instead of
+// averaging them in as a weighted mean does. First-order regression on
+// features is NFOR's model (Bitterli et al. 2016); here the feature is
+// alpha.
+
+// Adds one offset's sums of w a and w a^2 (a = alpha'(q) - alpha'(p)) into
+// moments[0], [1] and of w a q per channel c into targets[c], for a row of
+// n pixels; planes `planeSize` apart; wa: scratch of n. The sums of w and
+// w q are the weighted mean's (the same weights).
+void accumulateAlphaRegression(const float* __restrict w, const float* __restrict alphaP,
+                               const float* __restrict alphaQ, const float* const* values, int n, float* moments,
+                               float* targets, size_t planeSize, float* __restrict wa) {
+    float* __restrict m1 = moments;
+    float* __restrict m2 = moments + planeSize;
+    for (int x = 0; x < n; ++x) {
+        const float fa = alphaQ[x] - alphaP[x];
+        wa[x] = w[x] * fa;
+        m1[x] += wa[x];
+        m2[x] += wa[x] * fa;
+    }
+    for (int c = 0; c < 3; ++c) {
+        const float* __restrict q = values[c];
+        float* __restrict t1 = targets + size_t(c) * planeSize;
+        for (int x = 0; x < n; ++x) t1[x] += wa[x] * q[x];
+    }
+}
+
+// Solves one pixel's 2x2 normal equations [s0 s1; s1 s2] [b0 b1]^T =
+// [t0 t1]^T per channel (s0 = sum w, s1 = sum w a, s2 = sum w a^2; t0 =
+// sum w q, t1 = sum w a q), with `ridge` x s0 added to s2 (a window whose
+// alpha hardly varies cannot fit a slope, and falls back to the weighted
+// mean): the intercepts b0 into value[0..2], and (M^-1)_00 = s2 / det, the
+// weight of the pixel's own value (its weight 1, its feature 0) in its
+// intercept, dF/dy for SURE, into hat. False where that is not finite.
+bool solveAlphaRegression(double s0, double s1, double s2, const double* t0, const double* t1, double ridge,
+                          float* value, float* hat) {
+    s2 += ridge * s0;
+    const double det = s0 * s2 - s1 * s1;
+    if (!(s0 > 0) || !(det > 1e-12 * s0 * s2)) return false;
+    for (int c = 0; c < 3; ++c) {
+        value[c] = float((s2 * t0[c] - s1 * t1[c]) / det);
+        if (!std::isfinite(value[c])) return false;
+    }
+    *hat = float(s2 / det);
+    return std::isfinite(*hat);
+}
+
 // Per pixel, the candidate filter of least estimated error, blended
 // smoothly (Rousselle, Manzi and Zwicker 2013, section 5). A candidate F's
 // error at p is estimated by Stein's unbiased risk estimate,
@@ -784,6 +840,8 @@ void checkOptions(const DenoiseOptions& o) {
     if (o.candidates < 1 || o.candidates > 4)
         throw std::invalid_argument(str("denoise: candidates ", o.candidates, " is outside [1, 4]"));
     radius(o.selectionRadius, "selectionRadius");
+    if (!(o.regressionRidge >= 0) || !finite(o.regressionRidge))
+        throw std::invalid_argument(str("denoise: regressionRidge ", o.regressionRidge, " must be >= 0"));
     positive(o.featureStrength, "featureStrength");
     positive(o.featureThreshold, "featureThreshold");
     positive(o.featurePrefilterStrength, "featurePrefilterStrength");
@@ -898,8 +956,13 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
         halves.k2 = options.colorStrength * options.colorStrength;
         const float strongestScale = std::ldexp(1.f, -2 * (options.candidates - 1));
         const bool withFeatures = !features.empty();
-        std::vector<std::vector<Plane>> filtered(candidates, std::vector<Plane>(planes, Plane(w, h, 0)));
-        std::vector<Plane> inverse(candidates, Plane(w, h, 0));
+        // The alpha-regression candidate, when there is alpha, comes after
+        // the weighted means and takes the weights of the strongest.
+        const bool regression = options.alphaRegression && hasAlpha;
+        const size_t regressionAt = candidates - 1;
+        const size_t filters = candidates + (regression ? 1 : 0);
+        std::vector<std::vector<Plane>> filtered(filters, std::vector<Plane>(planes, Plane(w, h, 0)));
+        std::vector<Plane> inverse(filters, Plane(w, h, 0));
         forEachTile(w, h, [&](const Rect& tile) {
             const int tw = tile.width(), n = tw * tile.height();
             const size_t tilePixels = static_cast<size_t>(n), tileRow = static_cast<size_t>(tw);
@@ -911,6 +974,13 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
             const size_t sumSize = size_t(channels) * size_t(n);
             std::vector<float> sumA(candidates * sumSize, 0.f), sumB(candidates * sumSize, 0.f),
                 weightsA(candidates * tilePixels, 0.f), weightsB(candidates * tilePixels, 0.f);
+            std::vector<float> momentsA, momentsB, targetsA, targetsB, regressionScratch(tileRow);
+            if (regression) {
+                momentsA.assign(2 * tilePixels, 0.f);
+                momentsB.assign(2 * tilePixels, 0.f);
+                targetsA.assign(3 * tilePixels, 0.f);
+                targetsB.assign(3 * tilePixels, 0.f);
+            }
             for (int dy = -radius; dy <= radius; ++dy)
                 for (int dx = -radius; dx <= radius; ++dx) {
                     const Rect r = partnersInside(tile, dx, dy, w, h);
@@ -957,6 +1027,21 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                             float* __restrict sa = &weightsA[j * tilePixels + base];
                             float* __restrict sb = &weightsB[j * tilePixels + base];
                             for (int x = 0; x < rw; ++x) sa[x] += wA[x], sb[x] += wB[x];
+                            if (regression && j == regressionAt) {
+                                // A is fitted on B's alpha and B on A's.
+                                const float* qa[3];
+                                const float* qb[3];
+                                for (int c = 0; c < 3; ++c) {
+                                    qa[c] = a[size_t(c)].row(y + dy) + r.x0 + dx;
+                                    qb[c] = b[size_t(c)].row(y + dy) + r.x0 + dx;
+                                }
+                                accumulateAlphaRegression(wA, b[3].row(y) + r.x0, b[3].row(y + dy) + r.x0 + dx, qa,
+                                                          rw, &momentsA[base], &targetsA[base], tilePixels,
+                                                          regressionScratch.data());
+                                accumulateAlphaRegression(wB, a[3].row(y) + r.x0, a[3].row(y + dy) + r.x0 + dx, qb,
+                                                          rw, &momentsB[base], &targetsB[base], tilePixels,
+                                                          regressionScratch.data());
+                            }
                             for (int c = 0; c < channels; ++c) {
                                 const float* __restrict qa = a[size_t(c)].row(y + dy) + r.x0 + dx;
                                 const float* __restrict qb = b[size_t(c)].row(y + dy) + r.x0 + dx;
@@ -984,9 +1069,35 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                         }
                         inverse[j].at(x, y) = 0.5f * (1.f / std::max(sa, 1.f) + 1.f / std::max(sb, 1.f));
                     }
+            // The regression's intercepts; where a solution is not finite,
+            // the weighted mean of its weights. Alpha itself is the mean's.
+            if (regression)
+                for (int y = tile.y0; y < tile.y1; ++y)
+                    for (int x = tile.x0; x < tile.x1; ++x) {
+                        const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
+                        auto solve = [&](const std::vector<float>& weights, const std::vector<float>& sums,
+                                         const std::vector<float>& moments, const std::vector<float>& targets,
+                                         float* value, float* hat) {
+                            double t0[3], t1[3];
+                            for (size_t c = 0; c < 3; ++c) {
+                                t0[c] = sums[regressionAt * sumSize + c * size_t(n) + i];
+                                t1[c] = targets[c * tilePixels + i];
+                            }
+                            return solveAlphaRegression(weights[regressionAt * tilePixels + i], moments[i],
+                                                        moments[tilePixels + i], t0, t1, options.regressionRidge,
+                                                        value, hat);
+                        };
+                        float va[3], vb[3], ha = 0, hb = 0;
+                        const bool ok = solve(weightsA, sumA, momentsA, targetsA, va, &ha) &&
+                                        solve(weightsB, sumB, momentsB, targetsB, vb, &hb);
+                        for (int c = 0; c < channels; ++c)
+                            filtered[candidates][size_t(c)].at(x, y) =
+                                ok && c < 3 ? 0.5f * (va[c] + vb[c]) : filtered[regressionAt][size_t(c)].at(x, y);
+                        inverse[candidates].at(x, y) = ok ? 0.5f * (ha + hb) : inverse[regressionAt].at(x, y);
+                    }
         });
         std::vector<Plane> selected =
-            candidates == 1 ? std::move(filtered[0])
+            filters == 1 ? std::move(filtered[0])
                             : selectCandidates(filtered, inverse, clamped, variance, options.selectionRadius);
 
         // The noisy image's local means, restored: NL-means averages each

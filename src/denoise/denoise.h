@@ -42,6 +42,13 @@ struct DenoiseOptions {
     // pixel by their estimated error (SURE, Rousselle et al. 2013) over boxes
     // of (2 selectionRadius + 1)^2 pixels; 1: the k_c filter alone.
     int candidates = 2;
+    // One more candidate for that choice, where the input has alpha: the
+    // intercept of a weighted line fit of the values against the other
+    // half's alpha (first-order regression, as NFOR fits its features),
+    // with the strongest candidate's weights and `regressionRidge` x the
+    // sum of the weights on the slope.
+    bool alphaRegression = true;
+    float regressionRidge = 1e-3f;
     int selectionRadius = 2;
     // Radius of the box that smooths the two-half variance estimate (1
     // degree of freedom per pixel on its own): 2 is 5x5.
