@@ -842,6 +842,8 @@ void checkOptions(const DenoiseOptions& o) {
     radius(o.selectionRadius, "selectionRadius");
     if (!(o.regressionRidge >= 0) || !finite(o.regressionRidge))
         throw std::invalid_argument(str("denoise: regressionRidge ", o.regressionRidge, " must be >= 0"));
+    if (!(o.regressionNoiseRidge >= 0) || !finite(o.regressionNoiseRidge))
+        throw std::invalid_argument(str("denoise: regressionNoiseRidge ", o.regressionNoiseRidge, " must be >= 0"));
     positive(o.featureStrength, "featureStrength");
     positive(o.featureThreshold, "featureThreshold");
     positive(o.featurePrefilterStrength, "featurePrefilterStrength");
@@ -1075,6 +1077,11 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                 for (int y = tile.y0; y < tile.y1; ++y)
                     for (int x = tile.x0; x < tile.x1; ++x) {
                         const size_t i = size_t(y - tile.y0) * size_t(tw) + size_t(x - tile.x0);
+                        // The slope's ridge: a constant, and the expected
+                        // square of the feature's own noise (a difference of
+                        // two pixels' alpha), scaled.
+                        const double ridge = double(options.regressionRidge) +
+                                             double(options.regressionNoiseRidge) * 2.0 * double(variance[3].at(x, y));
                         auto solve = [&](const std::vector<float>& weights, const std::vector<float>& sums,
                                          const std::vector<float>& moments, const std::vector<float>& targets,
                                          float* value, float* hat) {
@@ -1084,8 +1091,7 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
                                 t1[c] = targets[c * tilePixels + i];
                             }
                             return solveAlphaRegression(weights[regressionAt * tilePixels + i], moments[i],
-                                                        moments[tilePixels + i], t0, t1, options.regressionRidge,
-                                                        value, hat);
+                                                        moments[tilePixels + i], t0, t1, ridge, value, hat);
                         };
                         float va[3], vb[3], ha = 0, hb = 0;
                         const bool ok = solve(weightsA, sumA, momentsA, targetsA, va, &ha) &&

@@ -45,10 +45,15 @@ struct DenoiseOptions {
     // One more candidate for that choice, where the input has alpha: the
     // intercept of a weighted line fit of the values against the other
     // half's alpha (first-order regression, as NFOR fits its features),
-    // with the strongest candidate's weights and `regressionRidge` x the
-    // sum of the weights on the slope.
+    // with the strongest candidate's weights. The slope's ridge is
+    // (regressionRidge + regressionNoiseRidge x 2 Var[alpha'](p)) x the sum
+    // of the weights: the second term scales the expected square of the
+    // feature's own noise (a difference of two pixels' alpha), so where
+    // alpha varies no more than its noise (inside a cloud at a few samples
+    // per pixel) the slope is shrunk to 0 and the fit is the weighted mean.
     bool alphaRegression = true;
     float regressionRidge = 1e-3f;
+    float regressionNoiseRidge = 4.f;
     int selectionRadius = 2;
     // Radius of the box that smooths the two-half variance estimate (1
     // degree of freedom per pixel on its own): 2 is 5x5.
