@@ -128,6 +128,17 @@ Image noisyMean(const DenoiseInput& in) {
     return img;
 }
 
+// Mean squared RGB error of a whole frame against a truth (row-major).
+double mseAgainst(const std::vector<Color>& truth, const Image& img) {
+    double sum = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const Color d = img.rgb(x, y) - truth[size_t(y) * size_t(img.width) + size_t(x)];
+            sum += double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z;
+        }
+    return sum / double(3 * img.pixelCount());
+}
+
 double meanRgb(const Image& img) {
     double sum = 0;
     for (size_t i = 0; i < img.pixelCount(); ++i)
@@ -479,15 +490,7 @@ TEST(DenoiseQuality, AColourThatFollowsAlphaKeepsItsRims) {
             in.alphaA.push_back(alpha + 0.01f * gaussian(rng));
             in.alphaB.push_back(alpha + 0.01f * gaussian(rng));
         }
-        auto error = [&](const Image& img) {
-            double sum = 0;
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x) {
-                    const Color d = img.rgb(x, y) - truth[size_t(y) * size_t(w) + size_t(x)];
-                    sum += double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z;
-                }
-            return sum / double(3 * w * h);
-        };
+        auto error = [&](const Image& img) { return mseAgainst(truth, img); };
         DenoiseOptions without;
         without.alphaRegression = false;
         const double noisy = error(noisyMean(in)), plain = error(denoise(in, without)), with = error(denoise(in));
@@ -528,15 +531,7 @@ TEST(DenoiseQuality, ANoisyFlatAlphaAddsNoNoise) {
                     (half ? in.alphaB : in.alphaA).push_back(0.95f + 0.04f * shared);
                 }
             }
-        auto error = [&](const Image& img) {
-            double sum = 0;
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x) {
-                    const Color d = img.rgb(x, y) - truth[size_t(y) * size_t(w) + size_t(x)];
-                    sum += double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z;
-                }
-            return sum / double(3 * w * h);
-        };
+        auto error = [&](const Image& img) { return mseAgainst(truth, img); };
         DenoiseOptions without, noNoiseRidge;
         without.alphaRegression = false;
         noNoiseRidge.regressionNoiseRidge = 0;
