@@ -36,6 +36,18 @@ std::vector<Color> colors(const ExrLayer& l, const char* c0, const char* c1, con
 
 ExrLayer rgbaLayer(const char* name, const Image& img) { return {name, {"R", "G", "B", "A"}, img.rgba}; }
 
+ExrLayer rgbLayer(const char* name, const Image& img) {
+    ExrLayer l{name, {"R", "G", "B"}, {}};
+    l.pixels.reserve(img.pixelCount() * 3);
+    for (size_t p = 0; p < img.pixelCount(); ++p)
+        l.pixels.insert(l.pixels.end(), {img.rgba[4 * p], img.rgba[4 * p + 1], img.rgba[4 * p + 2]});
+    return l;
+}
+
+bool isDenoiserInput(const ExrLayer& l) {
+    return l.name == EvenHalfLayer || l.name == OddHalfLayer || l.name == EmittedEvenLayer || l.name == EmittedOddLayer;
+}
+
 Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads) {
     const size_t pixels = size_t(width) * size_t(height);
     const ExrLayer* even = findLayer(layers, EvenHalfLayer);
@@ -48,6 +60,12 @@ Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, i
     in.halfB = colors(*odd, "R", "G", "B", pixels);
     in.alphaA = channel(*even, "A", pixels);
     in.alphaB = channel(*odd, "A", pixels);
+    const ExrLayer* emittedEven = findLayer(layers, EmittedEvenLayer);
+    const ExrLayer* emittedOdd = findLayer(layers, EmittedOddLayer);
+    if (emittedEven && emittedOdd) {
+        in.emittedA = colors(*emittedEven, "R", "G", "B", pixels);
+        in.emittedB = colors(*emittedOdd, "R", "G", "B", pixels);
+    }
     if (const ExrLayer* l = findLayer(layers, "albedo")) in.albedo = colors(*l, "R", "G", "B", pixels);
     if (const ExrLayer* l = findLayer(layers, "normal")) in.normal = colors(*l, "X", "Y", "Z", pixels);
     if (const ExrLayer* l = findLayer(layers, "depth")) in.depth = channel(*l, "Z", pixels);

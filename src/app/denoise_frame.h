@@ -15,12 +15,22 @@ namespace vdbmarch {
 inline constexpr const char* NoisyLayer = "noisy";
 inline constexpr const char* EvenHalfLayer = "even";
 inline constexpr const char* OddHalfLayer = "odd";
+// The emitted part of each half (PathRadiance::emitted; RGB), where the
+// render kept it: the denoiser filters the rest apart and adds it back.
+inline constexpr const char* EmittedEvenLayer = "emitted_even";
+inline constexpr const char* EmittedOddLayer = "emitted_odd";
+// The four layers above: written with a denoised EXR, dropped from a
+// preview-only one.
+bool isDenoiserInput(const ExrLayer& l);
 
 // An RGBA image as a layer named `name`.
 ExrLayer rgbaLayer(const char* name, const Image& img);
+// Its RGB only.
+ExrLayer rgbLayer(const char* name, const Image& img);
 
-// The denoised frame from the half layers (EvenHalfLayer, OddHalfLayer) and
-// the albedo, normal and depth AOV layers among `layers` when present;
+// The denoised frame from the half layers (EvenHalfLayer, OddHalfLayer),
+// their emitted parts (EmittedEvenLayer, EmittedOddLayer) and the albedo,
+// normal and depth AOV layers among `layers` when present;
 // channels are found by name, in any order. InputError when a half is
 // missing.
 Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads);

@@ -62,7 +62,7 @@ int runMerge(const MergeArgs& a) {
         }
     }
     // The halves stay in the EXR only when it is denoised (as one process writes it).
-    if (mode != "on") f.layers.erase(std::remove_if(f.layers.begin(), f.layers.end(), isHalf), f.layers.end());
+    if (mode != "on") f.layers.erase(std::remove_if(f.layers.begin(), f.layers.end(), isDenoiserInput), f.layers.end());
     writeExr(a.output, f.image, f.attributes, f.layers);
     if (!a.png.empty()) writePng(a.png, preview, float(a.exposure ? *a.exposure : sceneExposure(f.attributes)));
     if (!a.quiet)

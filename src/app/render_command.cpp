@@ -230,6 +230,10 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     const bool denoiseHere = denoiseMode == RenderSettings::Denoise::On ||
                              (denoiseMode == RenderSettings::Denoise::Preview && !a.png.empty());
     options.keepHalves = tile.any() ? denoiseMode != RenderSettings::Denoise::Off && !tile.byPasses() : denoiseHere;
+    // The emission seen straight is denoised apart (docs/denoise.md), where
+    // the scene has emissive media or sphere lights the camera can see.
+    options.keepEmitted = (options.keepHalves || (tile.byPasses() && denoiseMode != RenderSettings::Denoise::Off)) &&
+                          sceneEmitsLight(desc);
 
     // Checkpoints: resume from the file when it is there (--resume: it must
     // be), save to it every --checkpoint-every seconds and on a signal.
@@ -304,6 +308,10 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         // halves for merge; a preview-only EXR drops them again.
         r.layers.push_back({EvenHalfLayer, {"R", "G", "B", "A"}, std::move(r.evenHalf.rgba)});
         r.layers.push_back({OddHalfLayer, {"R", "G", "B", "A"}, std::move(r.oddHalf.rgba)});
+        if (!r.emittedEven.empty()) {
+            r.layers.push_back(rgbLayer(EmittedEvenLayer, r.emittedEven));
+            r.layers.push_back(rgbLayer(EmittedOddLayer, r.emittedOdd));
+        }
         if (!tile.any()) {
             const auto d0 = std::chrono::steady_clock::now();
             preview = denoiseFrame(r.image.width, r.image.height, r.layers, desc.render.threads);
@@ -312,7 +320,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
                 r.layers.push_back(rgbaLayer(NoisyLayer, r.image));
                 r.image = preview;
             } else {
-                r.layers.resize(r.layers.size() - 2);
+                r.layers.erase(std::remove_if(r.layers.begin(), r.layers.end(), isDenoiserInput), r.layers.end());
             }
         }
     }

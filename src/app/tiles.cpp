@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/command_line.h"
+#include "app/denoise_frame.h"
 #include "core/hash.h"
 #include "core/memory.h"
 #include "render/render.h"
@@ -93,6 +94,15 @@ std::vector<ExrLayer> passLayers(const RenderResult& result) {
                 l.pixels.insert(l.pixels.end(), {c.x, c.y, c.z, float(odd ? p.oddT[i] : p.T[i])});
             }
             layers.push_back(std::move(l));
+            // The emitted part's sums (RenderOptions::keepEmitted).
+            if (p.E.empty()) continue;
+            ExrLayer e{str("pass", p.pass, odd ? "emittedodd" : "emitted"), {"R", "G", "B"}, {}};
+            e.pixels.reserve(p.E.size() * 3);
+            for (size_t i = 0; i < p.E.size(); ++i) {
+                const Color c = (odd ? p.oddE[i] : p.E[i]).rounded();
+                e.pixels.insert(e.pixels.end(), {c.x, c.y, c.z});
+            }
+            layers.push_back(std::move(e));
         }
     return layers;
 }
@@ -225,7 +235,22 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
                 L[i] = ColorSum(Color(v[2], v[1], v[0]));
                 T[i] = v[3];
             }
+            // The emitted part's sums, where the parts kept them (B, G, R).
+            const std::string emittedName = str("pass", p, odd ? "emittedodd" : "emitted");
+            for (const ExrLayer& l : t.contents.layers) {
+                if (l.name != emittedName) continue;
+                if (l.channels != std::vector<std::string>{"B", "G", "R"})
+                    throw InputError(str(t.path, ": damaged part: layer ", emittedName, " is not B, G, R"));
+                std::vector<ColorSum>& E = odd ? pass.oddE : pass.E;
+                E.resize(pixels);
+                for (size_t i = 0; i < pixels; ++i) {
+                    const float* v = &l.pixels[3 * i];
+                    E[i] = ColorSum(Color(v[2], v[1], v[0]));
+                }
+            }
         }
+        if (pass.E.size() != pass.oddE.size())
+            throw InputError(str(t.path, ": damaged part: pass ", p, " has one of its two emitted layers only"));
         sums.fold(pass);
     }
     MergedTiles out;
@@ -241,6 +266,11 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
             const Image half = odd ? sums.oddHalf(frame.width(), frame.height()) : sums.evenHalf(frame.width(), frame.height());
             out.frame.layers.push_back({odd ? "odd" : "even", {"R", "G", "B", "A"}, half.rgba});
         }
+        if (!sums.E.empty())
+            for (const bool odd : {false, true}) {
+                const Image half = sums.emittedHalf(frame.width(), frame.height(), odd);
+                out.frame.layers.push_back(rgbLayer(odd ? EmittedOddLayer : EmittedEvenLayer, half));
+            }
     }
     return out;
 }

@@ -856,7 +856,9 @@ void checkOptions(const DenoiseOptions& o) {
 
 }  // namespace
 
-Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
+namespace {
+
+Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options) {
     if (in.width < 0 || in.height < 0)
         throw std::invalid_argument(str("denoise: invalid frame size ", in.width, "x", in.height));
     checkOptions(options);
@@ -1142,6 +1144,56 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
             }
         });
     });
+    return out;
+}
+
+}  // namespace
+
+Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
+    if (in.width < 0 || in.height < 0)
+        throw std::invalid_argument(str("denoise: invalid frame size ", in.width, "x", in.height));
+    const size_t pixels = size_t(std::max(in.width, 0)) * size_t(std::max(in.height, 0));
+    checkSize(in.halfA.size(), pixels, "halfA", false);
+    checkSize(in.halfB.size(), pixels, "halfB", false);
+    checkSize(in.emittedA.size(), pixels, "emittedA", true);
+    checkSize(in.emittedB.size(), pixels, "emittedB", true);
+    if (in.emittedA.empty() != in.emittedB.empty())
+        throw std::invalid_argument("denoise: emittedA and emittedB must both be given or both be empty");
+    // Nothing emitted anywhere: the whole image as one (bit for bit what no
+    // emitted part gives).
+    auto zero = [](const Color& c) { return c.x == 0 && c.y == 0 && c.z == 0; };
+    if (std::all_of(in.emittedA.begin(), in.emittedA.end(), zero) &&
+        std::all_of(in.emittedB.begin(), in.emittedB.end(), zero)) {
+        if (in.emittedA.empty()) return denoiseWhole(in, options);
+        DenoiseInput whole = in;
+        whole.emittedA.clear();
+        whole.emittedB.clear();
+        return denoiseWhole(whole, options);
+    }
+    // The scattered light (each half minus its emitted part) and the emitted
+    // part, each denoised on its own with the same alpha and features; the
+    // image is their sum, its alpha the scattered part's.
+    DenoiseInput scattered = in, emitted = in;
+    scattered.emittedA.clear();
+    scattered.emittedB.clear();
+    emitted.emittedA.clear();
+    emitted.emittedB.clear();
+    for (size_t p = 0; p < pixels; ++p) {
+        scattered.halfA[p] = in.halfA[p] - in.emittedA[p];
+        scattered.halfB[p] = in.halfB[p] - in.emittedB[p];
+    }
+    emitted.halfA = in.emittedA;
+    emitted.halfB = in.emittedB;
+    // The scattered part alone is a smooth glow, over which NL-means moves
+    // light at scales the restoring Gaussian of step 9 leaves: restored at
+    // half its sigma (the sample plume at 139 spp: low-frequency error 1.17x
+    // the noisy image's with 4 pixels, 1.07x with 2, and 4 % less MSE).
+    DenoiseOptions scatteredOptions = options;
+    scatteredOptions.restoreSigma = 0.5f * options.restoreSigma;
+    Image out = denoiseWhole(scattered, scatteredOptions);
+    const Image e = denoiseWhole(emitted, options);
+    for (size_t p = 0; p < out.pixelCount(); ++p)
+        for (int c = 0; c < 3; ++c) out.rgba[4 * p + size_t(c)] += e.rgba[4 * p + size_t(c)];
     return out;
 }
 

@@ -22,6 +22,12 @@ struct DenoiseInput {
     // are required; alpha may be absent (both empty: the output is opaque).
     std::vector<Color> halfA, halfB;
     std::vector<float> alphaA, alphaB;
+    // Optional (both or neither): the part of each half emitted by media and
+    // lights and seen with no scattering (sharp, and nearly noise-free where
+    // the renderer integrates emission smoothly). The rest, the scattered
+    // light, is denoised apart from it, and the emitted part on its own: a
+    // fire's sharp base is not averaged with the smoke's noisy glow.
+    std::vector<Color> emittedA, emittedB;
     // Optional features, each the mean over all the pixel's samples (noisy
     // in volumes: the first event is stochastic), see docs/aovs.md.
     std::vector<Color> albedo;  // first-event albedo (0: nothing met)

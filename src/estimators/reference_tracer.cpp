@@ -31,11 +31,12 @@ public:
         PathState start;
         start.guide = mGuide.get();
         if (!mChromatic) return tracePath(ctx, cameraRay, region, -1, rng, start);
-        PathRadiance out{Color(0), 0.f, Color(0)};
+        PathRadiance out{Color(0), 0.f, Color(0), Color(0)};
         for (int c = 0; c < 3; ++c) {
             PathRadiance p = tracePath(ctx, cameraRay, region, c, rng, start);
             out.L[c] = p.L[c];
             out.direct[c] = p.direct[c];
+            out.emitted[c] = p.emitted[c];
             out.transmittance += p.transmittance / 3;
         }
         return out;

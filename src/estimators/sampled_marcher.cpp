@@ -148,7 +148,7 @@ private:
                     const StepTerms st = stepTerms(mp, len);
                     if (!isBlack(mp.emission)) {
                         L += beta * T * st.absorbedA * mp.emission;
-                        if (mTallyDirect) tallyEmission(ctx, beta * T * st.absorbedA * mp.emission);
+                        tallyEmission(ctx, beta * T * st.absorbedA * mp.emission);
                     }
                     const float base = mp.scatters() ? average(T * st.absorbedS) : 0.f;  // sigma_s T(t0) S(kappa, len)
                     if (base > 0) {

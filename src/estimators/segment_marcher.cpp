@@ -27,10 +27,12 @@ SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumin
 }
 
 PathRadiance SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
-    if (!mTallyDirect) return trace(cameraRay, rng, ctx);
-    scratch(ctx).direct = Color(0);
+    MarcherScratch& m = scratch(ctx);
+    m.direct = Color(0);
+    m.emitted = Color(0);
     PathRadiance r = trace(cameraRay, rng, ctx);
-    r.direct = scratch(ctx).direct;
+    if (mTallyDirect) r.direct = m.direct;
+    r.emitted = m.emitted;
     return r;
 }
 
@@ -53,7 +55,9 @@ PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, Threa
     // The background seen in glass reflections that were counted whole
     // (mirroredLight): part of what the camera sees through.
     float mirroredThrough = 0;
-    auto done = [&](float transmittance) { return PathRadiance{L, transmittance + mirroredThrough, Color(0)}; };
+    auto done = [&](float transmittance) {
+        return PathRadiance{L, transmittance + mirroredThrough, Color(0), Color(0)};
+    };
     for (;; ++path.bounce) {
         const RaySegment seg = nextRaySegment(scene, ray);
         const SurfaceHit& h = seg.surface;
@@ -68,7 +72,11 @@ PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, Threa
         };
         const bool seen = !path.lightsCounted && !path.mirrorCounted;
         if (light >= 0) {
-            if (seen) addSeen(beta * scene.lights[size_t(light)].emittedRadiance());
+            if (seen) {
+                const Color Le = beta * scene.lights[size_t(light)].emittedRadiance();
+                addSeen(Le);
+                if (path.diffuseBounces == 0) scratch(ctx).emitted += Le;
+            }
             return done(0.f);
         }
         if (!hit) {
@@ -104,7 +112,7 @@ PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, Threa
             ++path.bounce;
             region = e.region;
             const PathRadiance t = traceFrom(e.ray, path, rng, ctx);
-            return {L + r.L + t.L, mirroredThrough + r.transmittance + t.transmittance, Color(0)};
+            return {L + r.L + t.L, mirroredThrough + r.transmittance + t.transmittance, Color(0), Color(0)};
         }
         if (e.kind == SurfaceEvent::Kind::Diffuse) {
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;

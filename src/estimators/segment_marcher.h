@@ -57,6 +57,8 @@ struct MarcherScratch final : ThreadContextExtension {
     // The direct / indirect AOVs (render.aovs): the camera path's direct
     // part so far, and that of the last inScattered() result.
     Color direct{0}, liDirect{0};
+    // PathRadiance::emitted of the camera path so far.
+    Color emitted{0};
 
     // The cache lookup along rays, made on first use.
     CacheLookup& lookup(const RadianceCache& cache);
@@ -120,9 +122,11 @@ protected:
     // (as added to L) is direct up to the first diffuse bounce; light in-
     // scattered with `weight` (L += weight * L_i) brings the direct part of
     // the last inScattered() result.
+    // Emission before the first bounce is also PathRadiance::emitted.
     void tallyEmission(ThreadContext& ctx, const Color& Le) const {
         MarcherScratch& m = scratch(ctx);
-        if (m.pathDepth <= 1) m.direct += Le;
+        if (mTallyDirect && m.pathDepth <= 1) m.direct += Le;
+        if (m.pathDepth == 0) m.emitted += Le;
     }
     void tallyInScattered(ThreadContext& ctx, const Color& weight) const { scratch(ctx).direct += weight * scratch(ctx).liDirect; }
     void applyInfiniteTail(int region, Color& beta) const;

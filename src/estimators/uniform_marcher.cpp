@@ -48,10 +48,8 @@ private:
                 Color Li = inScattered(ctx, region, x, ray.d, mp, rng, q);
                 StepTerms st = stepTerms(mp, dx);
                 L += beta * (st.absorbedA * mp.emission + st.absorbedS * Li);
-                if (mTallyDirect) {
-                    tallyEmission(ctx, beta * st.absorbedA * mp.emission);
-                    tallyInScattered(ctx, beta * st.absorbedS);
-                }
+                if (!isBlack(mp.emission)) tallyEmission(ctx, beta * st.absorbedA * mp.emission);
+                if (mTallyDirect) tallyInScattered(ctx, beta * st.absorbedS);
                 beta *= st.T;
                 if (!russianRoulette(beta, rng)) {
                     beta = Color(0);

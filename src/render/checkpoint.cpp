@@ -15,7 +15,7 @@ namespace vdbmarch {
 
 namespace {
 
-constexpr int CheckpointFormat = 2;
+constexpr int CheckpointFormat = 3;
 const char* const Magic = "vdbmarch checkpoint ";
 
 // FNV-1a over 64-bit words (the last partial word zero-padded): a checksum
@@ -75,6 +75,8 @@ public:
         array(p.T);
         array(p.oddL);
         array(p.oddT);
+        array(p.E);
+        array(p.oddE);
     }
     void finish() {
         const uint64_t h = mHash.value();
@@ -86,7 +88,9 @@ private:
     WordHash mHash;
 };
 
-nlohmann::json passHeader(const PhotonPassSums& p) { return {{"pass", p.pass}, {"samples", p.samples}, {"pixels", p.L.size()}}; }
+nlohmann::json passHeader(const PhotonPassSums& p) {
+    return {{"pass", p.pass}, {"samples", p.samples}, {"pixels", p.L.size()}, {"emitted", p.E.size()}};
+}
 
 // Reads the arrays back in the order they were written, never past the end.
 class Reader {
@@ -109,6 +113,9 @@ public:
         array(p.T, n);
         array(p.oddL, n);
         array(p.oddT, n);
+        const size_t e = h.at("emitted").get<size_t>();
+        array(p.E, e);
+        array(p.oddE, e);
     }
     bool done() const { return mAt == mSize; }
 
@@ -135,6 +142,7 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
         {"pixels", c.sums.L.size()},
         {"sums_samples", c.sums.samples},
         {"converged", c.sums.convergedAt.size()},
+        {"emitted", c.sums.E.size()},
         {"open", passHeader(c.open)},
         {"aovs",
          {{"depth", c.aovs.depth.size()},
@@ -156,6 +164,8 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
         w.array(c.sums.oddL);
         w.array(c.sums.oddT);
         w.array(c.sums.convergedAt);
+        w.array(c.sums.E);
+        w.array(c.sums.oddE);
         w.pass(c.open);
         for (const PhotonPassSums& p : c.passSums) w.pass(p);
         w.array(c.aovs.depth);
@@ -222,6 +232,8 @@ RenderCheckpoint readCheckpointFile(const std::string& path, const CheckpointIde
         read.array(c.sums.oddL, pixels);
         read.array(c.sums.oddT, pixels);
         read.array(c.sums.convergedAt, h.at("converged").get<size_t>());
+        read.array(c.sums.E, h.at("emitted").get<size_t>());
+        read.array(c.sums.oddE, h.at("emitted").get<size_t>());
         c.sums.samples = h.at("sums_samples").get<int>();
         read.pass(c.open, h.at("open"));
         for (const auto& p : h.at("passes")) {

@@ -134,6 +134,13 @@ void PixelSums::fold(const PhotonPassSums& pass) {
         oddL[i] += pass.oddL[i].rounded();
         oddT[i] += double(float(pass.oddT[i]));
     }
+    if (!pass.E.empty()) {
+        if (E.empty()) E.assign(L.size(), Color(0)), oddE.assign(L.size(), Color(0));
+        for (size_t i = 0; i < L.size(); ++i) {
+            E[i] += pass.E[i].rounded();
+            oddE[i] += pass.oddE[i].rounded();
+        }
+    }
     samples += pass.samples;
 }
 
@@ -308,6 +315,10 @@ void addCameraSample(const Scene& scene, const Estimator& marcher, ThreadContext
         open.oddL[local].add(pr.L);
         open.oddT[local] += pr.transmittance;
     }
+    if (!open.E.empty()) {
+        open.E[local].add(pr.emitted);
+        if (s & 1) open.oddE[local].add(pr.emitted);
+    }
     if (!aovs.any()) return;
     if (aovs.splitDirect()) aovSums.direct[local] += pr.direct;
     if (aovs.firstEvent()) {
@@ -326,6 +337,21 @@ void addCameraSample(const Scene& scene, const Estimator& marcher, ThreadContext
 
 Image PixelSums::evenHalf(int width, int height) const { return halfImage(*this, width, height, false); }
 Image PixelSums::oddHalf(int width, int height) const { return halfImage(*this, width, height, true); }
+
+Image PixelSums::emittedHalf(int width, int height, bool odd) const {
+    if (E.empty()) return Image();
+    Image img(width, height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const size_t p = size_t(y) * size_t(width) + size_t(x);
+            int ne, no;
+            halfCounts(0, samplesOf(p), ne, no);
+            const int n = odd ? no : ne;
+            if (n == 0) continue;
+            img.set(x, y, (odd ? oddE[p] : E[p] - oddE[p]) / float(n), 1.f);
+        }
+    return img;
+}
 
 NoiseEstimate estimateNoise(const PixelSums& sums, int firstSample) {
     NoiseTotals totals;
@@ -353,6 +379,14 @@ uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs) {
     const uint64_t perPixel = 2 * (sizeof(Color) + sizeof(ColorSum) + 2 * sizeof(double)) + 4 * sizeof(float) +
                               sizeof(int) + AovSums::bytesPerPixel(aovs);
     return uint64_t(width) * uint64_t(height) * perPixel;
+}
+
+bool sceneEmitsLight(const SceneDesc& desc) {
+    for (const MediumDesc& m : desc.media)
+        if (m.hasEmission) return true;
+    for (const LightDesc& l : desc.lights)
+        if (l.type == LightDesc::Type::Sphere) return true;
+    return false;
 }
 
 void checkImageMemory(int width, int height, const AovSet& aovs) {
@@ -483,6 +517,10 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             open.T.assign(pixels, 0.0);
             open.oddL.assign(pixels, ColorSum());
             open.oddT.assign(pixels, 0.0);
+            if (options.keepEmitted) {
+                open.E.assign(pixels, ColorSum());
+                open.oddE.assign(pixels, ColorSum());
+            }
         }
         open.samples += samples;
     };
@@ -658,6 +696,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     if (options.keepHalves) {
         result.evenHalf = sums.evenHalf(ww, wh);
         result.oddHalf = sums.oddHalf(ww, wh);
+        result.emittedEven = sums.emittedHalf(ww, wh, false);
+        result.emittedOdd = sums.emittedHalf(ww, wh, true);
     }
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() + resumedSeconds;
     result.counters = counters();

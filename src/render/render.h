@@ -52,6 +52,9 @@ struct RenderOptions {
     std::optional<CheckpointHooks> checkpoint;
     // Keep the two half renders in the result (the denoiser's input).
     bool keepHalves = false;
+    // Also sum PathRadiance::emitted per pixel in halves (E, oddE), which the
+    // denoiser takes apart from the scattered light (docs/denoise.md).
+    bool keepEmitted = false;
 };
 
 // An RGB sum in double: thousands of samples add up without the float
@@ -80,6 +83,10 @@ struct PhotonPassSums {
     // give two independent half renders (the noise estimate, the denoiser).
     std::vector<ColorSum> oddL;
     std::vector<double> oddT;
+    // With RenderOptions::keepEmitted: the sums of PathRadiance::emitted (the
+    // emission seen before any scattering), all samples and odd ones; empty
+    // otherwise.
+    std::vector<ColorSum> E, oddE;
 };
 
 // A render's per-pixel totals. Samples are summed per photon pass and the
@@ -91,6 +98,7 @@ struct PixelSums {
     std::vector<double> T;
     std::vector<Color> oddL;  // over the odd-index samples (PhotonPassSums::oddL)
     std::vector<double> oddT;
+    std::vector<Color> E, oddE;  // PhotonPassSums::E, oddE folded (empty without them)
     int samples = 0;
     // Adaptive sampling (render.noise): the samples a pixel had when it
     // stopped receiving more; 0 while it still samples (or without it).
@@ -105,6 +113,9 @@ struct PixelSums {
     // independent estimates of each pixel.
     Image evenHalf(int width, int height) const;
     Image oddHalf(int width, int height) const;
+    // The same halves of the emitted part (RGB, alpha 1); empty images
+    // without E.
+    Image emittedHalf(int width, int height, bool odd) const;
 };
 
 // The noise of a render estimated from its two halves, without a
@@ -161,6 +172,7 @@ struct RenderResult {
     // Whether the render stopped because the noise target was met.
     bool reachedNoiseTarget = false;
     Image evenHalf, oddHalf;  // the two half renders (RenderOptions::keepHalves)
+    Image emittedEven, emittedOdd;  // their emitted parts (keepHalves and keepEmitted)
     int photonPasses = 1; // progressive photon passes used (illumination/illumination.h)
     // The AOVs render.aovs asks for, as EXR layers (docs/aovs.md), in the
     // order depth, albedo, normal, direct, indirect.
@@ -181,6 +193,9 @@ constexpr float NoDepth = 1e10f;
 // not fit in this machine's memory: per pixel the sums (PixelSums and the
 // open pass's), the RGBA result, and the sums and layers of the AOVs.
 void checkImageMemory(int width, int height, const AovSet& aovs = {});
+// The scene emits light a camera ray can meet before any scattering: an
+// emissive medium or a sphere light (RenderOptions::keepEmitted).
+bool sceneEmitsLight(const SceneDesc& desc);
 // The bytes checkImageMemory checks.
 uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs = {});
 

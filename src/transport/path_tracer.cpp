@@ -102,7 +102,13 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         L += c;
         if (events <= 1) direct += c;
     };
-    auto result = [&](float transmittance) { return PathRadiance{L, transmittance, direct}; };
+    // Emission and lights seen before any scattering event (PathRadiance::emitted).
+    Color emitted(0);
+    auto addEmitted = [&](const Color& c, int events) {
+        add(c, events);
+        if (events == 0) emitted += c;
+    };
+    auto result = [&](float transmittance) { return PathRadiance{L, transmittance, direct, emitted}; };
     MediumPoint mp;
     // Copies split from the path at a segment's collision: traced once the
     // free flight's walk has returned (their own walks reuse the thread
@@ -241,7 +247,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 evalMedia(ctx, region, x, mp);
                 ++ctx.counters.marchSamples;
                 // Emission: sigma_a L_e / sigma_maj at every tentative collision.
-                if (!isBlack(mp.emission)) add(beta * mp.sigma_a * mp.emission / sigmaMaj, st.depth);
+                if (!isBlack(mp.emission)) addEmitted(beta * mp.sigma_a * mp.emission / sigmaMaj, st.depth);
                 float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
                 float u = rng.uniform() * sigmaMaj;
                 if (u < sa) {
@@ -263,6 +269,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const PathRadiance r = tracePath(ctx, c.ray, region, channel, rng, cs);
             L += c.beta * r.L;
             direct += c.beta * r.direct;
+            emitted += c.beta * r.emitted;
         }
         if (isBlack(beta)) return result(0.f);
         if (scattered) {
@@ -289,7 +296,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 w = sphereCausticPathWeight(scene, st.lensSphere, st.lensRefractions, light, st.lastPoint, st.lastDir,
                                             st.lastPdf, ray.at(tEnd));
             }
-            if (!st.mirrorCounted) add(beta * l.emittedRadiance() * w, st.depth);
+            if (!st.mirrorCounted) addEmitted(beta * l.emittedRadiance() * w, st.depth);
             return result(0.f);
         }
         if (!hit) {
@@ -320,6 +327,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const PathRadiance pr = tracePath(ctx, pe.mirror.ray, pe.mirror.region, channel, rng, sr);
             L += br * pr.L;
             direct += br * pr.direct;
+            emitted += br * pr.emitted;
         }
         const SurfaceEvent& e = pe.event;
         Color weight = pe.weight;

@@ -83,6 +83,11 @@ struct PathRadiance {
     // AOV (docs/aovs.md). Zero for paths that start at depth >= 2; marchers
     // fill it only when render.aovs asks for "direct" or "indirect".
     Color direct;
+    // The part of L emitted by media and lights and seen with no scattering
+    // event (straight, or through glass): sharp and nearly noise-free where
+    // the estimator integrates emission smoothly, so the denoiser takes it
+    // apart from the scattered light (docs/denoise.md, "Emission apart").
+    Color emitted;
 };
 
 // The radiance the path ray (in `region`) brings back, from `state`.

@@ -80,6 +80,29 @@ TEST_F(TilesCli, TilesAreDenoisedAfterMergeLikeOneProcess) {
     for (const ExrLayer& l : readExrContents(work("p_single.exr")).layers) EXPECT_NE(l.name, "even");
 }
 
+// The sample plume emits light: a denoised render keeps the emitted part
+// of each half (layers emitted_even, emitted_odd), which the denoiser takes
+// apart from the scattered light; tiles carry them to merge, and the merged
+// frame is denoised as one process denoises it.
+TEST_F(TilesCli, AnEmissiveSceneIsDenoisedAfterMergeLikeOneProcess) {
+    auto plume = [&](const std::string& out, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"render", samplePath("plume.json"), "--spp", "4", "--res", "40x30",
+                                         "--step", "0.05", "-q", "-o", out};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const CliResult r = cli(args);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+    };
+    plume("single.exr", {"--denoise", "--threads", "2"});
+    plume("t0.exr", {"--denoise", "--tile", "0/2", "--threads", "1"});
+    plume("t1.exr", {"--denoise", "--tile", "1/2", "--threads", "2"});
+    ASSERT_EQ(merge({"t0.exr", "t1.exr"}).exitCode, 0);
+    const CliResult same = identical("merged.exr", "single.exr");
+    EXPECT_EQ(same.exitCode, 0) << same.out;
+    std::set<std::string> names;
+    for (const ExrLayer& l : readExrContents(work("single.exr")).layers) names.insert(l.name);
+    for (const char* n : {"noisy", "even", "odd", "emitted_even", "emitted_odd"}) EXPECT_TRUE(names.count(n)) << n;
+}
+
 TEST_F(TilesCli, MergedTilesAreBitIdenticalToOneProcess) {
     render("single.exr", {"--aovs", "depth,albedo,direct,indirect"});
     renderTiles(4, {"--aovs", "depth,albedo,direct,indirect", "--threads", "1"});
@@ -236,10 +259,14 @@ TEST_F(TilesCli, PartsByPhotonPassesMergeBitIdentically) {
     renderGlass("b.exr", {"--passes", "1-4", "--threads", "2"});  // crosses the refinements at passes 1 and 3
     renderGlass("c.exr", {"--passes", "4-5", "--threads", "1"});  // starts after both: makes them itself
     const ExrContents c = readExrContents(work("c.exr"));
-    // The pass's sums, and those of its odd-index samples (the noise estimate).
-    ASSERT_EQ(c.layers.size(), 2u);
+    // The pass's sums, and those of its odd-index samples (the noise
+    // estimate); and, as the sample's sphere light is seen, the sums of the
+    // emission seen straight, which the denoiser takes apart.
+    ASSERT_EQ(c.layers.size(), 4u);
     EXPECT_EQ(c.layers[0].name, "pass4");
-    EXPECT_EQ(c.layers[1].name, "pass4odd");
+    EXPECT_EQ(c.layers[1].name, "pass4emitted");
+    EXPECT_EQ(c.layers[2].name, "pass4emittedodd");  // the file keeps layers in name order
+    EXPECT_EQ(c.layers[3].name, "pass4odd");
     ASSERT_EQ(merge({"c.exr", "a.exr", "b.exr"}).exitCode, 0);
     const CliResult same = identical("merged.exr", "single.exr");
     EXPECT_EQ(same.exitCode, 0) << same.out;
@@ -250,6 +277,14 @@ TEST_F(TilesCli, PartsByPhotonPassesMergeBitIdentically) {
     // The same sums in the same order: the same noise estimate.
     ASSERT_TRUE(single.count("vdbmarch:noiseEstimate"));
     EXPECT_EQ(merged["vdbmarch:noiseEstimate"], single["vdbmarch:noiseEstimate"]);
+    // Denoised: the halves and their emitted parts rebuilt from the passes'
+    // sums are one process's, and so is the denoised frame.
+    renderGlass("d_single.exr", {"--denoise"});
+    renderGlass("d_a.exr", {"--denoise", "--passes", "0-2"});
+    renderGlass("d_b.exr", {"--denoise", "--passes", "2-5"});
+    ASSERT_EQ(merge({"d_a.exr", "d_b.exr"}, "d_merged.exr").exitCode, 0);
+    const CliResult denoised = identical("d_merged.exr", "d_single.exr");
+    EXPECT_EQ(denoised.exitCode, 0) << denoised.out;
     expectCliError(merge({"a.exr", "c.exr"}), {"3 of 5 photon passes missing: 1, 2, 3", "nothing written"});
     renderGlass("b2.exr", {"--passes", "0-2"});
     expectCliError(merge({"a.exr", "b2.exr", "c.exr"}), {"a.exr and b2.exr both hold photon pass 0"});

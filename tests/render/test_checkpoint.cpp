@@ -107,6 +107,30 @@ TEST_P(CheckpointMethods, ResumedRenderIsBitIdentical) {
 
 INSTANTIATE_TEST_SUITE_P(Methods, CheckpointMethods, ::testing::ValuesIn(estimatorMethods()), methodParamName);
 
+// The emitted part's halves (RenderOptions::keepEmitted, the denoiser's
+// input) are part of the state, in the open pass and the folded sums.
+TEST(Checkpoint, TheEmittedPartResumesBitIdentically) {
+    TempDir dir("checkpoint_emitted");
+    for (Method method : {Method::Guided, Method::Reference}) {
+        const auto scene = buildScene(loadSceneFile(
+            samplePath("plume.json"), {"camera.resolution=[24,16]", "render.spp=10", "photons.count=10000",
+                                       "photons.spp_per_pass=2", "render.step=0.12", methodOverride(method)}));
+        RenderOptions options;
+        options.keepHalves = options.keepEmitted = true;
+        const RenderResult whole = renderImage(*scene, options);
+        ASSERT_FALSE(whole.emittedEven.empty());
+        for (int stopAt : {3, 8}) {
+            const RenderCheckpoint state = interrupted(*scene, options, stopAt, dir / "ck");
+            const RenderResult r = resumed(*scene, options, state);
+            const std::string what = str(methodName(method), ", stopped at ", state.nextSample);
+            expectSameRender(whole, r, what);
+            EXPECT_TRUE(sameBits(whole.emittedEven.rgba, r.emittedEven.rgba)) << what;
+            EXPECT_TRUE(sameBits(whole.emittedOdd.rgba, r.emittedOdd.rgba)) << what;
+            EXPECT_TRUE(sameBits(whole.evenHalf.rgba, r.evenHalf.rgba)) << what;
+        }
+    }
+}
+
 TEST(Checkpoint, APartByPhotonPassesResumesBitIdentical) {
     TempDir dir("checkpoint");
     const auto scene = smallScene(Method::Guided);
