@@ -122,16 +122,12 @@ bool RayPdf::sampleMixture(double u, const Mixture& mix, int& step, float& offse
 }
 
 bool RayPdf::stepOffCrossing(const FoldSampler& folds, float& t, int& step, float& offset) const {
-    // A draw exactly on a fold's crossing (the folds' density is 0 there:
-    // FoldSampler::sample) moves to the next float: the light at that one
-    // float point is bounded only by its distance to the fold, which can be
-    // far below a float step.
-    for (int i = 0; i < folds.count(); ++i)
-        if (t == folds.crossing(i)) {
-            t = std::nextafter(t, Infinity);
-            return locate(t, step, offset);
-        }
-    return true;
+    // A draw exactly on a fold's crossing moves to the next float
+    // (FoldSampler::offCrossing).
+    const float moved = folds.offCrossing(t);
+    if (moved == t) return true;
+    t = moved;
+    return locate(t, step, offset);
 }
 
 double RayPdf::mixturePdf(int step, float offset, const Mixture& mix, float t) const {

@@ -98,6 +98,12 @@ float FoldSampler::sample(float u) const {
     return t == mT[i] ? std::nextafter(t, side * Infinity) : t;
 }
 
+float FoldSampler::offCrossing(float t) const {
+    for (int i = 0; i < mCount; ++i)
+        if (t == mT[i]) return std::nextafter(t, Infinity);
+    return t;
+}
+
 double FoldSampler::pdf(float t) const {
     double p = 0;
     for (int i = 0; i < mCount; ++i) {

@@ -44,6 +44,12 @@ public:
 
     float sample(float u) const;
     double pdf(float t) const;
+    // t, or the next float up where t is exactly a crossing: what every
+    // other sampler's draw becomes there. At the float point t_f the light
+    // is bounded only by how far that point lies from the fold, which can be
+    // far below a float step (values of 1e6-1e7 where its neighbourhood
+    // holds about 10); the fold density leaves t_f too (sample()).
+    float offCrossing(float t) const;
 
 private:
     float mT[MaxCrossings] = {}, mW[MaxCrossings] = {};

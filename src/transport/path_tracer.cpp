@@ -179,10 +179,16 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         // A real scattering event at x (media mp there): next-event
         // estimation, then the next direction (the guide's or the phase's).
         // False when max_depth ends the path.
-        auto scatterAt = [&](const Vec3& x, float t, const MediumPoint& mp) {
+        auto scatterAt = [&](Vec3 x, float t, const MediumPoint& mp) {
             if (++st.depth > maxDepth) {
                 beta = Color(0);
                 return false;
+            }
+            // A collision exactly on a fold's crossing moves to the next
+            // float, as every sampler's draw does (FoldSampler::offCrossing).
+            if (!folds.empty()) {
+                const float moved = folds.offCrossing(t);
+                if (moved != t) t = moved, x = ray.at(t);
             }
             ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
             const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);

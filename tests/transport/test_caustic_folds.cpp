@@ -164,6 +164,29 @@ double foldWindowMass(double tf, double w, double a, double b) {
     return cdf(b) - cdf(a);
 }
 
+// No sampler takes the float point t_f of a crossing: the fold density's
+// draws skip it (sample()), and any other draw that lands on it (the
+// marcher's histogram, the path tracer's tracking collisions) moves to the
+// next float up, where the fold density is positive and finite.
+TEST(CausticFolds, NoDrawStaysOnACrossing) {
+    FoldSampler fs;
+    fs.add(0.3f, 0.1f);
+    fs.add(0.9f, 0.2f);
+    for (float tf : {0.3f, 0.9f}) {
+        const float moved = fs.offCrossing(tf);
+        EXPECT_EQ(moved, std::nextafter(tf, 2.f));
+        EXPECT_GT(fs.pdf(moved), 0.0);
+        EXPECT_TRUE(std::isfinite(fs.pdf(moved)));
+    }
+    for (float t : {0.f, 0.2999f, std::nextafter(0.3f, 1.f), 0.5f, 0.95f}) EXPECT_EQ(fs.offCrossing(t), t);
+    Rng rng(3);
+    for (int i = 0; i < 100000; ++i) {
+        const float t = fs.sample(rng.uniform());
+        ASSERT_NE(t, 0.3f);
+        ASSERT_NE(t, 0.9f);
+    }
+}
+
 TEST(CausticFolds, TheSamplersDensityMatchesItsSamples) {
     FoldSampler fs;
     fs.add(0.3f, 0.1f);
