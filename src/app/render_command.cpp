@@ -127,7 +127,7 @@ void validate(const RenderArgs& a) {
 // the process holds now, each medium's load (volume/medium.h) and the image;
 // photons and the cache are checked where they are made (docs/memory.md).
 // Refuses a render that cannot fit; returns the prediction.
-uint64_t checkRenderMemory(const SceneDesc& desc, const PixelRect& window) {
+uint64_t checkRenderMemory(const SceneDesc& desc, const PixelRect& window, bool emitted) {
     uint64_t held = residentMemoryBytes(), peak = held, media = 0;
     for (const MediumDesc& m : desc.media) {
         const MediumMemory need = predictMediumMemory(m);
@@ -138,7 +138,7 @@ uint64_t checkRenderMemory(const SceneDesc& desc, const PixelRect& window) {
     // Rendering adds the image and what the threads, Embree and the EXR
     // writer take (about 8 MB, measured on the sample scenes at 8x8 pixels).
     constexpr uint64_t RenderOverhead = uint64_t(8) << 20;
-    const uint64_t image = imageMemoryBytes(window.width(), window.height(), desc.render.aovs);
+    const uint64_t image = imageMemoryBytes(window.width(), window.height(), desc.render.aovs, emitted);
     peak = std::max(peak, held + image + RenderOverhead);
     checkMemory(peak, str("this render (media ", formatBytes(media), " once loaded, image ", formatBytes(image),
                           ", with the grids' loading peak and what the process holds)"));
@@ -209,8 +209,10 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     }
     const TileRequest tile = parseTileRequest(a.tile, a.crop, a.passes);
     const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
-    checkImageMemory(window.width(), window.height(), desc.render.aovs);  // before any volume is loaded
-    const uint64_t predictedMemory = checkRenderMemory(desc, window);
+    // The emitted part's sums, where a denoised render of the scene may keep them.
+    const bool emitted = desc.render.denoise != RenderSettings::Denoise::Off && sceneEmitsLight(desc);
+    checkImageMemory(window.width(), window.height(), desc.render.aovs, emitted);  // before any volume is loaded
+    const uint64_t predictedMemory = checkRenderMemory(desc, window, emitted);
     std::unique_ptr<Scene> scene = buildScene(desc);
     double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 

@@ -373,11 +373,13 @@ PixelRect tileOfFrame(int index, int count, int width, int height) {
     return {0, row(index), width, row(index + 1)};
 }
 
-uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs) {
+uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs, bool emitted) {
     // The totals, the open pass's sums, the RGBA result and the AOVs.
-    // Each twice: all samples and the odd-index half.
+    // Each twice: all samples and the odd-index half. The emitted part: its
+    // totals and open sums, twice, and its two RGB layers.
     const uint64_t perPixel = 2 * (sizeof(Color) + sizeof(ColorSum) + 2 * sizeof(double)) + 4 * sizeof(float) +
-                              sizeof(int) + AovSums::bytesPerPixel(aovs);
+                              sizeof(int) + AovSums::bytesPerPixel(aovs) +
+                              (emitted ? 2 * (sizeof(Color) + sizeof(ColorSum)) + 6 * sizeof(float) : 0);
     return uint64_t(width) * uint64_t(height) * perPixel;
 }
 
@@ -389,8 +391,8 @@ bool sceneEmitsLight(const SceneDesc& desc) {
     return false;
 }
 
-void checkImageMemory(int width, int height, const AovSet& aovs) {
-    checkMemory(imageMemoryBytes(width, height, aovs),
+void checkImageMemory(int width, int height, const AovSet& aovs, bool emitted) {
+    checkMemory(imageMemoryBytes(width, height, aovs, emitted),
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
 
@@ -405,7 +407,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // Buffers hold the window's pixels; random streams are keyed by the
     // pixel's index in the whole frame.
     const int ww = window.width(), wh = window.height();
-    checkImageMemory(ww, wh, rs.aovs);
+    checkImageMemory(ww, wh, rs.aovs, options.keepEmitted);
     const size_t pixels = size_t(ww) * size_t(wh);
     const bool timed = options.timeBudget > 0;
     const AovSet& aovs = rs.aovs;

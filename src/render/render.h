@@ -191,13 +191,14 @@ constexpr float NoDepth = 1e10f;
 
 // Refuses (InputError naming camera.resolution) an image whose buffers do
 // not fit in this machine's memory: per pixel the sums (PixelSums and the
-// open pass's), the RGBA result, and the sums and layers of the AOVs.
-void checkImageMemory(int width, int height, const AovSet& aovs = {});
+// open pass's), the RGBA result, and the sums and layers of the AOVs and,
+// with `emitted` (RenderOptions::keepEmitted), of the emitted part.
+void checkImageMemory(int width, int height, const AovSet& aovs = {}, bool emitted = false);
 // The scene emits light a camera ray can meet before any scattering: an
 // emissive medium or a sphere light (RenderOptions::keepEmitted).
 bool sceneEmitsLight(const SceneDesc& desc);
 // The bytes checkImageMemory checks.
-uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs = {});
+uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs = {}, bool emitted = false);
 
 // Tile `index` of `count` of a width x height frame: horizontal bands of
 // whole rows (the unit an EXR scanline file stores), rows
