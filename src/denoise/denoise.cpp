@@ -858,21 +858,32 @@ void checkOptions(const DenoiseOptions& o) {
 
 namespace {
 
-Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options) {
+// Throws std::invalid_argument on a bad size or option (denoise()'s contract).
+void checkInput(const DenoiseInput& in, const DenoiseOptions& options) {
     if (in.width < 0 || in.height < 0)
         throw std::invalid_argument(str("denoise: invalid frame size ", in.width, "x", in.height));
     checkOptions(options);
-    const int w = in.width, h = in.height;
-    const size_t pixels = size_t(w) * size_t(h);
+    const size_t pixels = size_t(in.width) * size_t(in.height);
     checkSize(in.halfA.size(), pixels, "halfA", false);
     checkSize(in.halfB.size(), pixels, "halfB", false);
-    checkSize(in.alphaA.size(), pixels, "alphaA", true);
-    checkSize(in.alphaB.size(), pixels, "alphaB", true);
-    if (in.alphaA.empty() != in.alphaB.empty())
-        throw std::invalid_argument("denoise: alphaA and alphaB must both be given or both be empty");
+    auto pair = [&](size_t a, size_t b, const char* nameA, const char* nameB) {
+        checkSize(a, pixels, nameA, true);
+        checkSize(b, pixels, nameB, true);
+        if ((a == 0) != (b == 0))
+            throw std::invalid_argument(str("denoise: ", nameA, " and ", nameB, " must both be given or both be empty"));
+    };
+    pair(in.alphaA.size(), in.alphaB.size(), "alphaA", "alphaB");
+    pair(in.emittedA.size(), in.emittedB.size(), "emittedA", "emittedB");
     checkSize(in.albedo.size(), pixels, "albedo", true);
     checkSize(in.normal.size(), pixels, "normal", true);
     checkSize(in.depth.size(), pixels, "depth", true);
+}
+
+// The whole algorithm on one image (its emitted part, if any, ignored);
+// `in` already checked.
+Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options) {
+    const int w = in.width, h = in.height;
+    const size_t pixels = size_t(w) * size_t(h);
     Image out(w, h);
     if (pixels == 0) return out;
 
@@ -1150,34 +1161,18 @@ Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options) {
 }  // namespace
 
 Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
-    if (in.width < 0 || in.height < 0)
-        throw std::invalid_argument(str("denoise: invalid frame size ", in.width, "x", in.height));
-    const size_t pixels = size_t(std::max(in.width, 0)) * size_t(std::max(in.height, 0));
-    checkSize(in.halfA.size(), pixels, "halfA", false);
-    checkSize(in.halfB.size(), pixels, "halfB", false);
-    checkSize(in.emittedA.size(), pixels, "emittedA", true);
-    checkSize(in.emittedB.size(), pixels, "emittedB", true);
-    if (in.emittedA.empty() != in.emittedB.empty())
-        throw std::invalid_argument("denoise: emittedA and emittedB must both be given or both be empty");
-    // Nothing emitted anywhere: the whole image as one (bit for bit what no
-    // emitted part gives).
+    checkInput(in, options);
+    const size_t pixels = size_t(in.width) * size_t(in.height);
+    // Nothing emitted anywhere (or no emitted part): the whole image as one,
+    // bit for bit what no emitted part gives.
     auto zero = [](const Color& c) { return c.x == 0 && c.y == 0 && c.z == 0; };
     if (std::all_of(in.emittedA.begin(), in.emittedA.end(), zero) &&
-        std::all_of(in.emittedB.begin(), in.emittedB.end(), zero)) {
-        if (in.emittedA.empty()) return denoiseWhole(in, options);
-        DenoiseInput whole = in;
-        whole.emittedA.clear();
-        whole.emittedB.clear();
-        return denoiseWhole(whole, options);
-    }
+        std::all_of(in.emittedB.begin(), in.emittedB.end(), zero))
+        return denoiseWhole(in, options);
     // The scattered light (each half minus its emitted part) and the emitted
     // part, each denoised on its own with the same alpha and features; the
     // image is their sum, its alpha the scattered part's.
     DenoiseInput scattered = in, emitted = in;
-    scattered.emittedA.clear();
-    scattered.emittedB.clear();
-    emitted.emittedA.clear();
-    emitted.emittedB.clear();
     for (size_t p = 0; p < pixels; ++p) {
         scattered.halfA[p] = in.halfA[p] - in.emittedA[p];
         scattered.halfB[p] = in.halfB[p] - in.emittedB[p];

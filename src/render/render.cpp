@@ -163,8 +163,10 @@ void halfCounts(int first, int n, int& even, int& odd) {
     even = n - odd;
 }
 
-// One half's mean image: the odd-index samples' sums, or the total minus them.
-Image halfImage(const PixelSums& s, int width, int height, bool odd) {
+// One half's mean image: per pixel `set(img, x, y, p, n)` with n > 0 the
+// half's sample count (pixels of no sample in that half stay 0).
+template <class SetPixel>
+Image halfImage(const PixelSums& s, int width, int height, bool odd, SetPixel&& set) {
     Image img(width, height);
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
@@ -172,12 +174,18 @@ Image halfImage(const PixelSums& s, int width, int height, bool odd) {
             int ne, no;
             halfCounts(0, s.samplesOf(p), ne, no);
             const int n = odd ? no : ne;
-            if (n == 0) continue;
-            const Color l = odd ? s.oddL[p] : s.L[p] - s.oddL[p];
-            const double t = odd ? s.oddT[p] : s.T[p] - s.oddT[p];
-            img.set(x, y, l / float(n), clamp(1.f - float(t / double(n)), 0.f, 1.f));
+            if (n > 0) set(img, x, y, p, n);
         }
     return img;
+}
+
+// The beauty's half: the odd-index samples' sums, or the total minus them.
+Image halfImage(const PixelSums& s, int width, int height, bool odd) {
+    return halfImage(s, width, height, odd, [&](Image& img, int x, int y, size_t p, int n) {
+        const Color l = odd ? s.oddL[p] : s.L[p] - s.oddL[p];
+        const double t = odd ? s.oddT[p] : s.T[p] - s.oddT[p];
+        img.set(x, y, l / float(n), clamp(1.f - float(t / double(n)), 0.f, 1.f));
+    });
 }
 
 // Mean and variance of the mean of one pixel from its sums over n samples
@@ -340,17 +348,9 @@ Image PixelSums::oddHalf(int width, int height) const { return halfImage(*this, 
 
 Image PixelSums::emittedHalf(int width, int height, bool odd) const {
     if (E.empty()) return Image();
-    Image img(width, height);
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) {
-            const size_t p = size_t(y) * size_t(width) + size_t(x);
-            int ne, no;
-            halfCounts(0, samplesOf(p), ne, no);
-            const int n = odd ? no : ne;
-            if (n == 0) continue;
-            img.set(x, y, (odd ? oddE[p] : E[p] - oddE[p]) / float(n), 1.f);
-        }
-    return img;
+    return halfImage(*this, width, height, odd, [&](Image& img, int x, int y, size_t p, int n) {
+        img.set(x, y, (odd ? oddE[p] : E[p] - oddE[p]) / float(n), 1.f);
+    });
 }
 
 NoiseEstimate estimateNoise(const PixelSums& sums, int firstSample) {
