@@ -41,6 +41,9 @@ constexpr float FarDepth = 1e9f;
 // E[median of the 8 squared differences to the neighbours] / sigma^2 for
 // i.i.d. Gaussian noise: 1.407, measured over 2e5 simulated pixels.
 constexpr float MedianSquaredDifferenceScale = 1.407f;
+// An emitted part (DenoiseInput::emittedA/B) whose halves differ by at most
+// this share of the image's half-difference variance is added unfiltered.
+constexpr double EmittedNoiseShare = 0.05;
 
 // ---------------------------------------------------------------------------
 // A float plane with `pad` replicated pixels on every side, so that patch
@@ -1186,6 +1189,25 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
     DenoiseOptions scatteredOptions = options;
     scatteredOptions.restoreSigma = 0.5f * options.restoreSigma;
     Image out = denoiseWhole(scattered, scatteredOptions);
+    // The emitted part is filtered only where its noise counts: the
+    // marchers integrate emission along the camera ray nearly noise-free
+    // (the sample plume: 2 % of the image's half-difference variance), and
+    // NL-means leaves such a part as it is (measured: the same MSE to four
+    // digits) at the cost of a second denoise (0.9 s at 480x640). Then its
+    // halves' mean is added as it is. Non-finite values always go through
+    // the filter, which cleans them.
+    double emittedNoise = 0, imageNoise = 0;
+    for (size_t p = 0; p < pixels; ++p) {
+        emittedNoise += double(lengthSquared(in.emittedA[p] - in.emittedB[p]));
+        imageNoise += double(lengthSquared(in.halfA[p] - in.halfB[p]));
+    }
+    if (std::isfinite(emittedNoise) && std::isfinite(imageNoise) && emittedNoise <= EmittedNoiseShare * imageNoise) {
+        for (size_t p = 0; p < pixels; ++p) {
+            const Color e = 0.5f * (in.emittedA[p] + in.emittedB[p]);
+            for (int c = 0; c < 3; ++c) out.rgba[4 * p + size_t(c)] += e[c];
+        }
+        return out;
+    }
     const Image e = denoiseWhole(emitted, options);
     for (size_t p = 0; p < out.pixelCount(); ++p)
         for (int c = 0; c < 3; ++c) out.rgba[4 * p + size_t(c)] += e.rgba[4 * p + size_t(c)];
