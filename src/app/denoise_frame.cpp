@@ -1,8 +1,11 @@
 #include "app/denoise_frame.h"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 
 #include "core/error.h"
+#include "core/threads.h"
 #include "denoise/denoise.h"
 
 namespace vdbmarch {
@@ -72,6 +75,56 @@ Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, i
     DenoiseOptions options;
     options.threads = threads;
     return denoise(in, options);
+}
+
+double predictDenoiseSeconds(int width, int height, const DenoiseShape& shape, int threads) {
+    if (width <= 0 || height <= 0) return 0;
+    // The denoiser works in tiles of 64 x 64 pixels, one thread per tile; a
+    // frame of as many tiles as threads (or the whole frame, if smaller)
+    // keeps every thread busy, as the frame itself will.
+    constexpr int Tile = 64;
+    const long tilesX = (width + Tile - 1) / Tile, tilesY = (height + Tile - 1) / Tile;
+    const long tiles = std::max(1L, std::min(tilesX * tilesY, long(resolveThreadCount(threads))));
+    const int w = int(std::min(long(width), Tile * tiles));
+    const long columns = (w + Tile - 1) / Tile;
+    const int h = int(std::min(long(height), Tile * ((tiles + columns - 1) / columns)));
+    // A smooth image with independent noise in each half (a hash of the
+    // pixel), so that every stage runs as on a render's: the emitted part
+    // noisy enough to be filtered apart (the costlier case).
+    const size_t n = size_t(w) * size_t(h);
+    auto noise = [](size_t p, uint32_t salt) {
+        uint32_t x = uint32_t(p) * 0x9E3779B9u ^ salt;
+        x ^= x >> 16;
+        x *= 0x85EBCA6Bu;
+        x ^= x >> 13;
+        x *= 0xC2B2AE35u;
+        x ^= x >> 16;
+        return float(x >> 8) * (1.f / 16777216.f) - 0.5f;
+    };
+    DenoiseInput in;
+    in.width = w;
+    in.height = h;
+    for (size_t p = 0; p < n; ++p) {
+        const float x = float(p % size_t(w)), y = float(p / size_t(w));
+        const float v = 0.5f + 0.3f * std::sin(x / 7) * std::cos(y / 5);
+        in.halfA.push_back(Color(v + 0.2f * noise(p, 1), v + 0.2f * noise(p, 2), v + 0.2f * noise(p, 3)));
+        in.halfB.push_back(Color(v + 0.2f * noise(p, 4), v + 0.2f * noise(p, 5), v + 0.2f * noise(p, 6)));
+        in.alphaA.push_back(0.8f + 0.1f * noise(p, 7));
+        in.alphaB.push_back(0.8f + 0.1f * noise(p, 8));
+        if (shape.emitted) {
+            in.emittedA.push_back(Color(0.2f * v + 0.1f * noise(p, 9)));
+            in.emittedB.push_back(Color(0.2f * v + 0.1f * noise(p, 10)));
+        }
+        if (shape.albedo) in.albedo.push_back(Color(0.9f + 0.1f * noise(p, 11)));
+        if (shape.normal) in.normal.push_back(Color(0.f, 0.5f + noise(p, 12), 1.f));
+        if (shape.depth) in.depth.push_back(3 + v + noise(p, 13));
+    }
+    DenoiseOptions options;
+    options.threads = threads;
+    const auto t0 = std::chrono::steady_clock::now();
+    const Image out = denoise(in, options);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return seconds * (double(width) * double(height)) / double(n);
 }
 
 }  // namespace vdbmarch

@@ -35,4 +35,17 @@ ExrLayer rgbLayer(const char* name, const Image& img);
 // missing.
 Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads);
 
+// What a frame's denoiser input holds besides the halves.
+struct DenoiseShape {
+    bool emitted = false;  // the emitted parts (EmittedEvenLayer, EmittedOddLayer)
+    bool albedo = false, normal = false, depth = false;  // AOV features
+};
+
+// The seconds denoiseFrame is expected to take on a width x height frame of
+// that shape with `threads` threads (0: all cores): a small synthetic frame
+// of the same shape, as many 64-pixel tiles as threads, denoised here and
+// now, its time scaled by the pixel count. What a timed render keeps back
+// from its budget for the denoiser.
+double predictDenoiseSeconds(int width, int height, const DenoiseShape& shape, int threads);
+
 }  // namespace vdbmarch

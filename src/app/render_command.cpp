@@ -147,11 +147,14 @@ uint64_t checkRenderMemory(const SceneDesc& desc, const PixelRect& window, bool 
 
 // Timings, counts and counters of a finished render (--stats).
 std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& scene, const RenderResult& r,
-                      double loadSeconds, double total, uint64_t predictedMemory) {
+                      double loadSeconds, double total, uint64_t predictedMemory, double denoiseSeconds,
+                      double denoiseReserve) {
     const RenderCounters& c = r.counters;
     nlohmann::json s;
     s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"photons_and_cache", r.illuminationSeconds},
                     {"total", total}};
+    if (denoiseSeconds >= 0) s["seconds"]["denoise"] = denoiseSeconds;
+    if (denoiseReserve > 0) s["seconds"]["denoise_reserved"] = denoiseReserve;
     s["photons"] = r.photons;
     s["photon_passes"] = r.photonPasses;
     s["cache_cells"] = r.cacheCells;
@@ -236,6 +239,14 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     // the scene has emissive media or sphere lights the camera can see.
     options.keepEmitted = (options.keepHalves || (tile.byPasses() && denoiseMode != RenderSettings::Denoise::Off)) &&
                           sceneEmitsLight(desc);
+    // A timed render that is denoised here keeps back the denoiser's
+    // predicted time (at most half the budget): --time is the whole run's.
+    if (options.timeBudget > 0 && denoiseHere && !tile.any()) {
+        const DenoiseShape shape{options.keepEmitted, desc.render.aovs.albedo, desc.render.aovs.normal,
+                                 desc.render.aovs.depth};
+        options.reserveSeconds = std::min(
+            predictDenoiseSeconds(window.width(), window.height(), shape, desc.render.threads), 0.5 * options.timeBudget);
+    }
 
     // Checkpoints: resume from the file when it is there (--resume: it must
     // be), save to it every --checkpoint-every seconds and on a signal.
@@ -335,7 +346,8 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (!a.saveScene.empty()) writeTextFileAtomic(a.saveScene, prettySceneJson(desc) + "\n");
     if (!a.png.empty()) writePng(a.png, preview, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total, predictedMemory));
+    if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total, predictedMemory,
+                                                                  denoiseSeconds, options.reserveSeconds));
     if (!checkpointPath.empty() && !a.keepCheckpoint) std::remove(checkpointPath.c_str());  // the render is whole
     if (!a.quiet)
         std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s%s\n",

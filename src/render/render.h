@@ -38,6 +38,9 @@ struct RenderOptions {
     // seconds (counted from runStart, so loading is included) are spent,
     // instead of render.spp samples.
     double timeBudget = 0;
+    // Seconds of timeBudget kept back for the work after the render (the
+    // denoiser): sweeps stop that much earlier.
+    double reserveSeconds = 0;
     std::optional<std::chrono::steady_clock::time_point> runStart;
     IlluminationOptions illumination;  // a baked cache to load (render --cache)
     // Render only these pixels of the frame (render --tile / --crop). Every
