@@ -196,7 +196,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             BeamMixture beams{&ctx, region, &vertex};
             const bool beamDirections = !guidedDirection && beams.attach(vertex, st.pointLightsByPhotons);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
-            const float deltaWeight = folds.empty() ? 1.f : foldTrackingWeight(ctx, lightDistances, folds, t, mp);
+            const float deltaWeight = foldTrackingWeight(ctx, lightDistances, folds, t, mp);
             const bool caustics = nextEvent(vertex, weights, deltaWeight);
             // Guided roulette and splitting of what follows the vertex.
             int paths = 1;
