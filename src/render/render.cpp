@@ -626,7 +626,9 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     } else {
         // Sweeps of whole samples per pixel while the next sample is expected
         // to finish within the budget (which also covers loading, measured
-        // from runStart); always at least one sweep. The first sweep is one
+        // from runStart, less what is kept back for the denoiser); always at
+        // least one sweep, and two samples where the halves are kept (the
+        // denoiser needs both). The first sweep is one
         // sample; later ones as many as fill about TimedSweepSeconds and fit
         // in the time left (a sweep makes a thread context per block of
         // pixels, whose set-up one sample per sweep paid for every sample:
@@ -670,7 +672,10 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             double elapsed = std::chrono::duration<double>(now - runStart).count();
             progress.set(elapsed / (budget / 0.98));
             if (checkNoise(spp)) break;
-            if (elapsed + 1.05 * perSample + photonsBeforeSample(spp) > budget) break;
+            // At least two samples where the halves are kept: the denoiser
+            // needs both (a one-sample render is written noisy).
+            if (first + spp >= (options.keepHalves ? 2 : 1) && elapsed + 1.05 * perSample + photonsBeforeSample(spp) > budget)
+                break;
         } while (spp < (1 << 24));
         progress.set(1.0);
     }

@@ -234,6 +234,17 @@ TEST(TimeBudgetReserve, EndsTheSweepsEarlier) {
     EXPECT_GE(b.spp, 1);
 }
 
+// A budget spent before the first sample still renders one sample per
+// pixel, and two where the halves are kept (the denoiser needs both).
+TEST(TimeBudgetReserve, ADenoisedRenderGetsTwoSamples) {
+    auto scene = buildScene(loadSceneFile(samplePath("cloud.json"), {"camera.resolution=[24,18]"}));
+    RenderOptions plain, halves;
+    plain.timeBudget = halves.timeBudget = 1e-6;
+    halves.keepHalves = true;
+    EXPECT_EQ(renderImage(*scene, plain).spp, 1);
+    EXPECT_EQ(renderImage(*scene, halves).spp, 2);
+}
+
 INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget,
                          ::testing::Combine(::testing::ValuesIn(estimatorMethods()),
                                             ::testing::Values(LiSource::Path, LiSource::Photons)),
