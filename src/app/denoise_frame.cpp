@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "core/threads.h"
 #include "denoise/denoise.h"
 
@@ -88,41 +89,34 @@ double predictDenoiseSeconds(int width, int height, const DenoiseShape& shape, i
     const int w = int(std::min(long(width), Tile * tiles));
     const long columns = (w + Tile - 1) / Tile;
     const int h = int(std::min(long(height), Tile * ((tiles + columns - 1) / columns)));
-    // A smooth image with independent noise in each half (a hash of the
-    // pixel), so that every stage runs as on a render's: the emitted part
-    // noisy enough to be filtered apart (the costlier case).
+    // A smooth image with independent noise in each half, so that every
+    // stage runs as on a render's: the emitted part noisy enough to be
+    // filtered apart (the costlier case).
     const size_t n = size_t(w) * size_t(h);
-    auto noise = [](size_t p, uint32_t salt) {
-        uint32_t x = uint32_t(p) * 0x9E3779B9u ^ salt;
-        x ^= x >> 16;
-        x *= 0x85EBCA6Bu;
-        x ^= x >> 13;
-        x *= 0xC2B2AE35u;
-        x ^= x >> 16;
-        return float(x >> 8) * (1.f / 16777216.f) - 0.5f;
-    };
+    Rng rng(1);
+    auto noise = [&] { return rng.uniform() - 0.5f; };
     DenoiseInput in;
     in.width = w;
     in.height = h;
     for (size_t p = 0; p < n; ++p) {
         const float x = float(p % size_t(w)), y = float(p / size_t(w));
         const float v = 0.5f + 0.3f * std::sin(x / 7) * std::cos(y / 5);
-        in.halfA.push_back(Color(v + 0.2f * noise(p, 1), v + 0.2f * noise(p, 2), v + 0.2f * noise(p, 3)));
-        in.halfB.push_back(Color(v + 0.2f * noise(p, 4), v + 0.2f * noise(p, 5), v + 0.2f * noise(p, 6)));
-        in.alphaA.push_back(0.8f + 0.1f * noise(p, 7));
-        in.alphaB.push_back(0.8f + 0.1f * noise(p, 8));
+        in.halfA.push_back(Color(v + 0.2f * noise(), v + 0.2f * noise(), v + 0.2f * noise()));
+        in.halfB.push_back(Color(v + 0.2f * noise(), v + 0.2f * noise(), v + 0.2f * noise()));
+        in.alphaA.push_back(0.8f + 0.1f * noise());
+        in.alphaB.push_back(0.8f + 0.1f * noise());
         if (shape.emitted) {
-            in.emittedA.push_back(Color(0.2f * v + 0.1f * noise(p, 9)));
-            in.emittedB.push_back(Color(0.2f * v + 0.1f * noise(p, 10)));
+            in.emittedA.push_back(Color(0.2f * v + 0.1f * noise()));
+            in.emittedB.push_back(Color(0.2f * v + 0.1f * noise()));
         }
-        if (shape.albedo) in.albedo.push_back(Color(0.9f + 0.1f * noise(p, 11)));
-        if (shape.normal) in.normal.push_back(Color(0.f, 0.5f + noise(p, 12), 1.f));
-        if (shape.depth) in.depth.push_back(3 + v + noise(p, 13));
+        if (shape.albedo) in.albedo.push_back(Color(0.9f + 0.1f * noise()));
+        if (shape.normal) in.normal.push_back(Color(0.f, 0.5f + noise(), 1.f));
+        if (shape.depth) in.depth.push_back(3 + v + noise());
     }
     DenoiseOptions options;
     options.threads = threads;
     const auto t0 = std::chrono::steady_clock::now();
-    const Image out = denoise(in, options);
+    denoise(in, options);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return seconds * (double(width) * double(height)) / double(n);
 }

@@ -638,7 +638,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         // photons did.
         constexpr double TimedSweepSeconds = 0.1;
         constexpr int MaxTimedSweep = 64;
-        const double budget = (options.timeBudget - std::max(options.reserveSeconds, 0.0)) * 0.98;
+        const double budget = options.timeBudget - std::max(options.reserveSeconds, 0.0);
         double perSample = 0;  // the camera part of one sample per pixel, last measured
         auto photonsBeforeSample = [&](int sample) {
             const int pass = photonPasses.passOf(sample);
@@ -652,7 +652,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             auto p0 = std::chrono::steady_clock::now();
             int n = 1;
             if (perSample > 0) {
-                const double room = budget - std::chrono::duration<double>(p0 - runStart).count() -
+                const double room = budget * 0.98 - std::chrono::duration<double>(p0 - runStart).count() -
                                     photonsBeforeSample(spp);
                 // A checkpoint is due at a sweep's end every hooks->everySeconds.
                 const double sweep = std::min(TimedSweepSeconds, hooks ? hooks->everySeconds : TimedSweepSeconds);
@@ -670,12 +670,12 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             perSample = (std::chrono::duration<double>(now - p0).count() - (illumination->stats.seconds - photonsBefore)) /
                         double(n);
             double elapsed = std::chrono::duration<double>(now - runStart).count();
-            progress.set(elapsed / (budget / 0.98));
+            progress.set(elapsed / budget);
             if (checkNoise(spp)) break;
             // At least two samples where the halves are kept: the denoiser
             // needs both (a one-sample render is written noisy).
-            if (first + spp >= (options.keepHalves ? 2 : 1) && elapsed + 1.05 * perSample + photonsBeforeSample(spp) > budget)
-                break;
+            const int fewest = options.keepHalves ? 2 : 1;
+            if (first + spp >= fewest && elapsed + 1.05 * perSample + photonsBeforeSample(spp) > budget * 0.98) break;
         } while (spp < (1 << 24));
         progress.set(1.0);
     }
