@@ -350,11 +350,14 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
                                                                   denoiseSeconds, options.reserveSeconds));
     if (!checkpointPath.empty() && !a.keepCheckpoint) std::remove(checkpointPath.c_str());  // the render is whole
     if (!a.quiet)
-        std::fprintf(stderr, "vdbmarch: %s%dx%d, %d spp, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s%s\n",
+        std::fprintf(stderr, "vdbmarch: %s%dx%d, %s, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s%s\n",
                      tile.count > 0 ? str("tile ", tile.index, "/", tile.count, " (rows ", r.window.y0, "-", r.window.y1 - 1, ") of ").c_str()
                      : tile.cropped ? str("crop ", a.crop, " of ").c_str()
                      : tile.byPasses() ? str("photon passes ", a.passes, " (samples ", r.firstSample, "-", r.firstSample + r.spp - 1, ") of ").c_str() : "",
-                     scene->camera->width(), scene->camera->height(), r.spp, methodLabel(desc.render).c_str(), double(scene->step),
+                     scene->camera->width(), scene->camera->height(),
+                     (r.meanSpp < r.spp - 0.05 ? str(r.spp, " spp (", std::round(r.meanSpp * 10) / 10, " on average)")
+                                               : str(r.spp, " spp")).c_str(),
+                     methodLabel(desc.render).c_str(), double(scene->step),
                      r.seconds,
                      r.illuminationSeconds > 0
                          ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s in ",

@@ -127,6 +127,11 @@ struct RenderSettings {
     // estimated RMSE over the image's mean is below it, sampling only the
     // blocks of pixels still above it (adaptive sampling, docs/noise.md).
     float noise = 0;
+    // Adaptive sampling in timed renders (render --time): at each noise
+    // check, blocks of pixels whose share of the time left is spent stop
+    // receiving samples, so the budget goes where it lowers the image's
+    // error most per second (docs/noise.md, "Timed renders").
+    bool adaptive = true;
     // The denoiser (docs/denoise.md): Preview denoises the PNG only; On also
     // the EXR's RGBA (the noisy beauty kept as a layer).
     enum class Denoise { Off, Preview, On } denoise = Denoise::Preview;

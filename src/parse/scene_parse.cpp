@@ -312,7 +312,7 @@ AovSet parseAovs(const JsonReader& r) {
 RenderSettings parseRender(const JsonReader& r) {
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
                  "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "guided_roulette", "aovs",
-                 "volume_sampling", "sphere_caustics", "beam_directions", "glass_splitting", "noise", "denoise"});
+                 "volume_sampling", "sphere_caustics", "beam_directions", "glass_splitting", "noise", "adaptive", "denoise"});
     RenderSettings s;
     {
         std::vector<std::string> names = {"auto"};
@@ -352,6 +352,7 @@ RenderSettings parseRender(const JsonReader& r) {
     s.beamDirections = r.boolean("beam_directions", s.beamDirections);
     s.glassSplitting = r.boolean("glass_splitting", s.glassSplitting);
     if (r.has("noise")) s.noise = float(r.numberIn("noise", 0, 1e-4, 10));
+    s.adaptive = r.boolean("adaptive", s.adaptive);
     {
         const std::string v = r.choice("denoise", "preview", {"preview", "on", "off"});
         s.denoise = v == "on" ? RenderSettings::Denoise::On

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 
 #include <tbb/blocked_range.h>
@@ -219,54 +220,146 @@ struct NoiseTotals {
     }
 };
 
+// The blocks of adaptive sampling at a check after n samples: each 8x8
+// block's per-sample standard deviation s_b (its pixels' variances times
+// their sample counts, RGB summed: docs/noise.md) and the image's noise.
+// False where a pixel lacks one of its halves.
+struct NoiseBlocks {
+    int bx = 0, by = 0;
+    std::vector<double> sigma;
+    std::vector<int> count;  // pixels in the block
+    NoiseEstimate image;
+    size_t of(int x, int y) const { return size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock); }
+};
+bool measureNoiseBlocks(const PixelSums& sums, const PhotonPassSums& open, int ww, int wh, int n, NoiseBlocks& out) {
+    out.bx = (ww + NoiseBlock - 1) / NoiseBlock;
+    out.by = (wh + NoiseBlock - 1) / NoiseBlock;
+    out.sigma.assign(size_t(out.bx) * size_t(out.by), 0.0);
+    out.count.assign(out.sigma.size(), 0);
+    NoiseTotals totals;
+    for (int y = 0; y < wh; ++y)
+        for (int x = 0; x < ww; ++x) {
+            const size_t p = size_t(y) * size_t(ww) + size_t(x);
+            Color L = sums.L[p], odd = sums.oddL[p], mean, var;
+            if (open.pass >= 0) {
+                L += open.L[p].rounded();
+                odd += open.oddL[p].rounded();
+            }
+            const int k = sums.convergedAt[p] > 0 ? sums.convergedAt[p] : n;
+            if (!pixelNoise(L, odd, 0, k, mean, var)) return false;
+            totals.add(mean, var);
+            out.sigma[out.of(x, y)] += double(float((double(var.x) + double(var.y) + double(var.z)) * k));
+            ++out.count[out.of(x, y)];
+        }
+    for (size_t b = 0; b < out.sigma.size(); ++b) out.sigma[b] = std::sqrt(out.sigma[b] / (3.0 * out.count[b]));
+    out.image = totals.estimate();
+    return true;
+}
+
+// Stops the pixels of the still-sampling blocks whose count n has reached
+// their target k a_b (sums.convergedAt = n); true when no pixel samples on.
+bool stopBlocksAt(PixelSums& sums, const NoiseBlocks& blocks, const std::vector<double>& target, int ww, int wh,
+                  int n) {
+    bool any = false;
+    for (int y = 0; y < wh; ++y)
+        for (int x = 0; x < ww; ++x) {
+            int& c = sums.convergedAt[size_t(y) * size_t(ww) + size_t(x)];
+            if (c == 0 && double(n) >= target[blocks.of(x, y)]) c = n;
+            any = any || c == 0;
+        }
+    return !any;
+}
+
 // The noise target (render.noise, docs/noise.md) at a check after n samples:
-// the two halves give every pixel's variance; true once the window's RMSE is
-// below noise x its mean. Until then each 8x8 block of pixels gets samples in
-// proportion to its per-sample standard deviation s_b, the allocation that
+// true once the window's estimated RMSE is below noise x its mean. Until
+// then each 8x8 block gets samples in proportion to s_b, the allocation that
 // minimises the image's MSE for a sample count (n_b = k s_b gives MSE =
 // mean(s_b) / k), with k set so that this MSE meets the target: a block
 // stops (sums.convergedAt) once n >= k s_b. The decisions depend only on the
 // sums, so the image is the same for any thread count.
 bool noiseTargetStep(PixelSums& sums, const PhotonPassSums& open, float noise, int ww, int wh, int n) {
-    const size_t pixels = size_t(ww) * size_t(wh);
-    std::vector<float> perSample(pixels);  // variance of one sample, RGB summed
-    NoiseTotals totals;
-    for (size_t p = 0; p < pixels; ++p) {
-        Color L = sums.L[p], odd = sums.oddL[p], mean, var;
-        if (open.pass >= 0) {
-            L += open.L[p].rounded();
-            odd += open.oddL[p].rounded();
-        }
-        const int k = sums.convergedAt[p] > 0 ? sums.convergedAt[p] : n;
-        if (!pixelNoise(L, odd, 0, k, mean, var)) return false;
-        perSample[p] = float((double(var.x) + double(var.y) + double(var.z)) * k);
-        totals.add(mean, var);
-    }
-    const NoiseEstimate image = totals.estimate();
-    const double target = double(noise) * image.mean;
-    if (image.rmse <= target) return true;
-    // s_b per block, and k from their pixel-weighted mean.
-    const int bx = (ww + NoiseBlock - 1) / NoiseBlock, by = (wh + NoiseBlock - 1) / NoiseBlock;
-    std::vector<double> sigma(size_t(bx) * size_t(by), 0.0);
-    std::vector<int> count(sigma.size(), 0);
-    for (int y = 0; y < wh; ++y)
-        for (int x = 0; x < ww; ++x) {
-            const size_t b = size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock);
-            sigma[b] += perSample[size_t(y) * size_t(ww) + size_t(x)];
-            ++count[b];
-        }
+    NoiseBlocks blocks;
+    if (!measureNoiseBlocks(sums, open, ww, wh, n, blocks)) return false;
+    const double target = double(noise) * blocks.image.mean;
+    if (blocks.image.rmse <= target) return true;
     double weighted = 0;
-    for (size_t b = 0; b < sigma.size(); ++b) {
-        sigma[b] = std::sqrt(sigma[b] / (3.0 * count[b]));
-        weighted += sigma[b] * count[b];
-    }
-    const double k = weighted / double(pixels) / (target * target);
+    for (size_t b = 0; b < blocks.sigma.size(); ++b) weighted += blocks.sigma[b] * blocks.count[b];
+    const double k = weighted / (double(ww) * double(wh)) / (target * target);
+    std::vector<double> samples(blocks.sigma.size());
+    for (size_t b = 0; b < samples.size(); ++b) samples[b] = k * blocks.sigma[b];
+    stopBlocksAt(sums, blocks, samples, ww, wh, n);
+    return false;
+}
+
+// Each pixel's camera time in a timed adaptive render: seconds summed over
+// the samples this process rendered, and how many.
+struct PixelTimes {
+    std::vector<double> seconds;
+    std::vector<int> samples;
+};
+
+// Adaptive sampling of a timed render (render.adaptive, docs/noise.md) at a
+// check after n samples, with `secondsLeft` of camera time left (summed over
+// the threads). Each block has s_b and t_b, its pixels' measured seconds
+// per sample. The allocation n_b = k s_b / sqrt(t_b) minimises the image's
+// MSE, sum_b s_b^2 / n_b, for the time sum_b t_b n_b; k is the water level
+// at which the still-sampling blocks' targets take up the time left, and a
+// block whose count has reached its target stops. The time left is taken a
+// fifth larger than predicted, so that a wrong prediction leaves a block
+// sampling rather than stopping it early. True when every pixel stopped.
+bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelTimes& times, int ww, int wh, int n,
+                       double secondsLeft) {
+    NoiseBlocks blocks;
+    if (!measureNoiseBlocks(sums, open, ww, wh, n, blocks)) return false;
+    const size_t nb = blocks.sigma.size();
+    std::vector<double> seconds(nb, 0.0), timed(nb, 0.0);
+    std::vector<char> active(nb, 0);
     for (int y = 0; y < wh; ++y)
         for (int x = 0; x < ww; ++x) {
-            int& c = sums.convergedAt[size_t(y) * size_t(ww) + size_t(x)];
-            if (c == 0 && double(n) >= k * sigma[size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock)]) c = n;
+            const size_t p = size_t(y) * size_t(ww) + size_t(x), b = blocks.of(x, y);
+            seconds[b] += times.seconds[p];
+            timed[b] += times.samples[p];
+            if (sums.convergedAt[p] == 0) active[b] = 1;
         }
-    return false;
+    // Blocks without a measured time (a resumed render's pixels that have
+    // not sampled since) keep sampling; a block's time is floored at a
+    // hundredth of the mean. A block of no noise at all (the background)
+    // has target 0: it stops, as it does towards a noise target.
+    double meanTime = 0, pixelsIn = 0;
+    for (size_t b = 0; b < nb; ++b) {
+        if (!active[b] || timed[b] <= 0) continue;
+        meanTime += seconds[b] / timed[b] * blocks.count[b];
+        pixelsIn += blocks.count[b];
+    }
+    if (pixelsIn == 0 || !(meanTime > 0)) return false;
+    meanTime /= pixelsIn;
+    std::vector<char> allocated(nb, 0);
+    std::vector<double> a(nb, 0.0), t(nb, 0.0);
+    for (size_t b = 0; b < nb; ++b) {
+        if (!active[b] || timed[b] <= 0) continue;
+        allocated[b] = 1;
+        t[b] = std::max(seconds[b] / timed[b], 0.01 * meanTime);
+        a[b] = blocks.sigma[b] / std::sqrt(t[b]);
+    }
+    // The water level: the time the active blocks' targets take beyond n,
+    // sum_b count_b t_b max(0, k a_b - n), equals the time left.
+    const double budget = 1.2 * std::max(secondsLeft, 0.0);
+    auto timeAt = [&](double k) {
+        double sum = 0;
+        for (size_t b = 0; b < nb; ++b)
+            if (allocated[b]) sum += blocks.count[b] * t[b] * std::max(0.0, k * a[b] - n);
+        return sum;
+    };
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 200 && timeAt(hi) < budget; ++i) hi *= 2;
+    for (int i = 0; i < 100; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (timeAt(mid) < budget ? lo : hi) = mid;
+    }
+    std::vector<double> target(nb, std::numeric_limits<double>::infinity());
+    for (size_t b = 0; b < nb; ++b)
+        if (allocated[b]) target[b] = hi * a[b];
+    return stopBlocksAt(sums, blocks, target, ww, wh, n);
 }
 
 // The samples [first, last) of the photon passes `passes` = [a, b) asked for
@@ -378,7 +471,7 @@ uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs, bool emitte
     // Each twice: all samples and the odd-index half. The emitted part: its
     // totals and open sums, twice, and its two RGB layers.
     const uint64_t perPixel = 2 * (sizeof(Color) + sizeof(ColorSum) + 2 * sizeof(double)) + 4 * sizeof(float) +
-                              sizeof(int) + AovSums::bytesPerPixel(aovs) +
+                              sizeof(int) + sizeof(double) + sizeof(int) + AovSums::bytesPerPixel(aovs) +
                               (emitted ? 2 * (sizeof(Color) + sizeof(ColorSum)) + 6 * sizeof(float) : 0);
     return uint64_t(width) * uint64_t(height) * perPixel;
 }
@@ -432,9 +525,16 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     PhotonPassSums open;  // the sums of the pass being rendered
     open.pass = -1;
     AovSums aovSums(aovs, pixels);
-    // Adaptive sampling towards the noise target (render.noise).
-    const bool adaptive = rs.noise > 0;
+    // Adaptive sampling: towards the noise target (render.noise), or in a
+    // timed render by each block's noise and measured time (render.adaptive).
+    const bool timedAdaptive = timed && rs.adaptive && rs.noise <= 0;
+    const bool adaptive = rs.noise > 0 || timedAdaptive;
     if (adaptive) sums.convergedAt.assign(pixels, 0);
+    PixelTimes times;
+    if (timedAdaptive) {
+        times.seconds.assign(pixels, 0.0);
+        times.samples.assign(pixels, 0);
+    }
     std::vector<RenderCounters> workBlockCounters(static_cast<size_t>(workBlocks));
     ProgressBar progress(options.progress, timed || options.checkpoint || rs.noise > 0 ? 1000 : workBlocks);
     const int threads = resolveThreadCount(rs.threads);
@@ -468,6 +568,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         if (c.sums.L.size() != pixels || c.nextSample < first || (!timed && c.nextSample > last))
             throw std::logic_error("renderImage: the checkpoint does not belong to this render");
         sums = c.sums;
+        if (adaptive && sums.convergedAt.size() != pixels) sums.convergedAt.assign(pixels, 0);
         open = c.open;
         result.passSums = c.passSums;
         aovSums = c.aovs;
@@ -491,9 +592,15 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                         for (int x = x0; x < std::min(x0 + WorkBlockSize, window.x1); ++x) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
-                            if (adaptive && sums.convergedAt[local] > 0) continue;  // met the noise target
+                            if (adaptive && sums.convergedAt[local] > 0) continue;  // stopped sampling
+                            const auto t0 = std::chrono::steady_clock::now();
                             for (int s = s0; s < s1; ++s)
                                 addCameraSample(scene, *marcher, ctx, x, y, pixel, s, local, open, aovSums);
+                            if (timedAdaptive) {
+                                times.seconds[local] +=
+                                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                                times.samples[local] += s1 - s0;
+                            }
                         }
                     workBlockCounters[size_t(workBlock)] += ctx.counters;
                     if (!timed && !hooks && !adaptive) progress.tick();
@@ -593,7 +700,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // The noise target (render.noise): checked at fixed sample counts.
     bool reachedTarget = false;
     auto checkNoise = [&](int n) {
-        if (!adaptive || !isNoiseCheck(n)) return false;
+        if (rs.noise <= 0 || !isNoiseCheck(n)) return false;
         return reachedTarget = noiseTargetStep(sums, open, rs.noise, ww, wh, n);
     };
 
@@ -640,6 +747,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         constexpr int MaxTimedSweep = 64;
         const double budget = options.timeBudget - std::max(options.reserveSeconds, 0.0);
         double perSample = 0;  // the camera part of one sample per pixel, last measured
+        double cameraSeconds = 0;  // the sweeps' camera time so far (wall)
         auto photonsBeforeSample = [&](int sample) {
             const int pass = photonPasses.passOf(sample);
             return pass != illumination->photonPass && photonPasses.needsWork(pass) ? firstIlluminationSeconds : 0.0;
@@ -667,11 +775,21 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             spp += n;
             auto now = std::chrono::steady_clock::now();
             // The camera part of the sweep (photons are predicted apart).
-            perSample = (std::chrono::duration<double>(now - p0).count() - (illumination->stats.seconds - photonsBefore)) /
-                        double(n);
+            const double camera =
+                std::chrono::duration<double>(now - p0).count() - (illumination->stats.seconds - photonsBefore);
+            perSample = camera / double(n);
+            cameraSeconds += camera;
             double elapsed = std::chrono::duration<double>(now - runStart).count();
             progress.set(elapsed / budget);
             if (checkNoise(spp)) break;
+            if (timedAdaptive && isNoiseCheck(spp)) {
+                // The time left in the pixels' seconds: wall time times the
+                // threads' measured pixel seconds per wall second.
+                double pixelSeconds = 0;
+                for (double t : times.seconds) pixelSeconds += t;
+                const double left = (budget * 0.98 - elapsed) * (cameraSeconds > 0 ? pixelSeconds / cameraSeconds : 0.0);
+                if (timedAdaptiveStep(sums, open, times, ww, wh, spp, left)) break;
+            }
             // At least two samples where the halves are kept: the denoiser
             // needs both (a one-sample render is written noisy).
             const int fewest = options.keepHalves ? 2 : 1;

@@ -2,6 +2,7 @@
 // random offset): transmittance, emission and single scattering in slabs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -205,8 +206,10 @@ TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
     std::string scenePath = samplePath("cloud.json");
     // Photon passes every other sample: the image depends on the sample
     // count only, not on where the budget ran out.
+    // Adaptive sampling off: its stops depend on the measured time.
     SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]", "render.max_depth=2", "photons.count=5000",
-                                            "photons.spp_per_pass=2", liOverride(li), methodOverride(method)});
+                                            "photons.spp_per_pass=2", "render.adaptive=false", liOverride(li),
+                                            methodOverride(method)});
     auto scene = buildScene(d);
     RenderOptions timed;
     timed.timeBudget = 0.5;
@@ -243,6 +246,89 @@ TEST(TimeBudgetReserve, ADenoisedRenderGetsTwoSamples) {
     halves.keepHalves = true;
     EXPECT_EQ(renderImage(*scene, plain).spp, 1);
     EXPECT_EQ(renderImage(*scene, halves).spp, 2);
+}
+
+// A slab of medium fills the left half of the frame; the right half sees
+// only the uniform background (no pixel noise at all).
+SceneDesc halfSlabScene(const std::vector<std::string>& extra) {
+    const std::string json = R"({"camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_deg": 40, "resolution": [32, 16]},
+        "media": [{"type": "homogeneous", "sigma_a": 0.5, "sigma_s": 1, "g": 0.5,
+                   "bounds": {"min": [-10, -10, -1], "max": [0, 10, 1]}}],
+        "background": [1, 1, 1], "render": {"method": "reference", "max_depth": 4, "seed": 5}})";
+    return parseSceneText(json, "slab.json", extra);
+}
+
+const ExrLayer* samplesLayer(const RenderResult& r) {
+    for (const ExrLayer& l : r.layers)
+        if (l.name == "samples") return &l;
+    return nullptr;
+}
+
+// Adaptive sampling of a timed render (render.adaptive, docs/noise.md): the
+// background's blocks, of zero noise, stop at the first check (16 samples)
+// and the slab's sample on; blocks stop whole; the samples layer says so.
+TEST(TimedAdaptive, BlocksOfNoNoiseStopAtTheFirstCheck) {
+    auto scene = buildScene(halfSlabScene({}));
+    RenderOptions timed;
+    timed.timeBudget = 1.0;
+    const RenderResult r = renderImage(*scene, timed);
+    ASSERT_GT(r.spp, 24) << "too slow a machine for a second of rendering to pass the first checks";
+    const ExrLayer* samples = samplesLayer(r);
+    ASSERT_NE(samples, nullptr);
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 32; ++x) {
+            const float n = samples->pixels[size_t(y) * 32 + size_t(x)];
+            EXPECT_EQ(n, samples->pixels[size_t(y / 8 * 8) * 32 + size_t(x / 8 * 8)]);
+            if (x >= 16) EXPECT_EQ(n, 16.f) << x << ", " << y;
+            if (x < 16) EXPECT_GT(n, 16.f) << x << ", " << y;
+        }
+    EXPECT_LT(r.meanSpp, double(r.spp));
+    EXPECT_EQ(*std::max_element(samples->pixels.begin(), samples->pixels.end()), float(r.spp));
+}
+
+// Stopping blocks by their noise does not move the image: the slab's mean
+// agrees with that of an evenly sampled render of 2048 samples per pixel,
+// within 4 standard errors of the difference (each from its halves).
+TEST(TimedAdaptive, AgreesWithEvenSampling) {
+    auto adaptive = buildScene(halfSlabScene({}));
+    RenderOptions timed;
+    timed.timeBudget = 1.0;
+    timed.keepHalves = true;
+    const RenderResult a = renderImage(*adaptive, timed);
+    ASSERT_GT(a.spp, 24);
+    RenderOptions even;
+    even.keepHalves = true;
+    const RenderResult b = renderImage(*buildScene(halfSlabScene({"render.spp=2048", "render.seed=6"})), even);
+    // Mean over the slab's pixels and RGB, and the variance of that mean.
+    auto slab = [](const RenderResult& r, double& variance) {
+        double sum = 0;
+        variance = 0;
+        size_t n = 0;
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x, ++n)
+                for (int c = 0; c < 3; ++c) {
+                    sum += r.image.rgb(x, y)[c];
+                    const double d = r.evenHalf.rgb(x, y)[c] - r.oddHalf.rgb(x, y)[c];
+                    variance += d * d / 4;
+                }
+        const double values = 3.0 * double(n);
+        variance /= values * values;
+        return sum / values;
+    };
+    double va, vb;
+    const double ma = slab(a, va), mb = slab(b, vb);
+    EXPECT_NEAR(ma, mb, 4 * std::sqrt(va + vb)) << "adaptive " << ma << " even " << mb;
+    EXPECT_GT(ma, 0.05);
+}
+
+// render.adaptive = false: every pixel gets the same samples.
+TEST(TimedAdaptive, OffSamplesEvenly) {
+    auto scene = buildScene(halfSlabScene({"render.adaptive=false"}));
+    RenderOptions timed;
+    timed.timeBudget = 0.5;
+    const RenderResult r = renderImage(*scene, timed);
+    EXPECT_EQ(samplesLayer(r), nullptr);
+    EXPECT_EQ(r.meanSpp, double(r.spp));
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, TimeBudget,
