@@ -2,12 +2,14 @@
 # The denoiser and the noise estimate against the truth, at equal time
 # (docs/denoise.md; BENCHMARKS.md, "Denoising and the noise target").
 # For each scene: a truth (the path tracer, TRUTH_FACTOR x the largest budget,
-# another seed), whose own noise (its two halves' estimate) is subtracted from
-# every MSE; then at each budget the default method raw (--no-denoise, --time)
-# and the same samples denoised (--denoise, the raw render's spp and seed; the
-# denoiser's time shown on top), each against the truth:
-# RMSE net of the truth's noise, low-frequency error, and the raw render's
-# own noise estimate beside its measured error.
+# another seed, sampled evenly), whose own noise (its two halves' estimate) is
+# subtracted from every MSE; then at each budget one render of the default
+# method with --denoise and --time (the denoiser's predicted time kept back
+# from the budget, adaptive sampling on unless EXTRA turns it off), whose
+# RGBA is the denoised image and whose `noisy` layer the raw one: the same
+# samples, so the two differ by the denoiser alone. Each against the truth:
+# RMSE net of the truth's noise, low-frequency error, and the render's own
+# noise estimate beside its measured error.
 # Usage: tools/bench_denoise.sh OUT SCENE...   (env: RES 160x120, BUDGETS "16",
 # THREADS 2, TRUTH_FACTOR 8, BIN build/bin/vdbmarch, EXTRA extra render options)
 set -euo pipefail
@@ -17,8 +19,8 @@ BIN="${BIN:-$ROOT/build/bin/vdbmarch}"; RES="${RES:-160x120}"; BUDGETS="${BUDGET
 THREADS="${THREADS:-2}"; TRUTH_FACTOR="${TRUTH_FACTOR:-8}"; EXTRA="${EXTRA:-}"
 mkdir -p "$OUT"
 field() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d'+sys.argv[1]))" "$2"; }
-metric() { "$BIN" compare "$1" "$2" | awk -v k="$3" '$1 == k {print $2}'; }
-echo "| scene | res | budget s | spp | raw RMSE / truth-noise-net | denoised RMSE net | MSE ratio | raw LF | denoised LF | raw noise estimated / measured (rel.) | truth rel. noise | denoise s |"
+metric() { "$BIN" compare "$1" "$2" ${4:+--layer "$4"} | awk -v k="$3" '$1 == k {print $2}'; }
+echo "| scene | res | budget s | mean spp | raw RMSE / truth-noise-net | denoised RMSE net | MSE ratio | raw LF | denoised LF | raw noise estimated / measured (rel.) | truth rel. noise | denoise s |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 for scene in "$@"; do
     name=$(basename "$scene" .json)
@@ -26,28 +28,26 @@ for scene in "$@"; do
     truth="$OUT/$name.$RES.truth.exr"
     if [ ! -f "$truth" ]; then
         "$BIN" render "$scene" -o "$truth" --res "$RES" --threads "$THREADS" --method reference \
-            --time "$(python3 -c "print($max * $TRUTH_FACTOR)")" --seed 777 --no-denoise -q --stats "$truth.json" $EXTRA
+            --time "$(python3 -c "print($max * $TRUTH_FACTOR)")" --seed 777 --no-denoise -q --stats "$truth.json" $EXTRA \
+            --set render.adaptive=false
     fi
     tn=$(field "$truth.json" "['noise_estimate']['rmse']")
     tm=$(field "$truth.json" "['noise_estimate']['mean']")
     for b in $BUDGETS; do
-        raw="$OUT/$name.$RES.$b.raw.exr"; den="$OUT/$name.$RES.$b.den.exr"
-        "$BIN" render "$scene" -o "$raw" --res "$RES" --threads "$THREADS" --time "$b" --seed 11 --no-denoise -q --stats "$raw.json" $EXTRA
-        # The same samples denoised: the raw render's spp and seed, so that the
-        # two images differ by the denoiser alone (two renders of the same time
-        # differ in spp, and their low-frequency noise by up to a third).
-        "$BIN" render "$scene" -o "$den" --res "$RES" --threads "$THREADS" --spp "$(field "$raw.json" "['spp']")" --seed 11 --denoise 2>"$den.log" --stats "$den.json" $EXTRA
-        dsec=$(sed -n 's/.*denoised in \([0-9.]*\) s.*/\1/p' "$den.log")
-        rr=$(metric "$raw" "$truth" rmse); rd=$(metric "$den" "$truth" rmse)
-        lr=$(metric "$raw" "$truth" low_frequency_error); ld=$(metric "$den" "$truth" low_frequency_error)
-        spp=$(field "$raw.json" "['spp']"); est=$(field "$raw.json" "['noise_estimate']['relative']")
+        run="$OUT/$name.$RES.$b.exr"
+        "$BIN" render "$scene" -o "$run" --res "$RES" --threads "$THREADS" --time "$b" --seed 11 --denoise -q \
+            --stats "$run.json" $EXTRA
+        dsec=$(field "$run.json" "['seconds']['denoise']")
+        rr=$(metric "$run" "$truth" rmse noisy); rd=$(metric "$run" "$truth" rmse)
+        lr=$(metric "$run" "$truth" low_frequency_error noisy); ld=$(metric "$run" "$truth" low_frequency_error)
+        spp=$(field "$run.json" "['mean_spp']"); est=$(field "$run.json" "['noise_estimate']['relative']")
         python3 - "$name" "$RES" "$b" "$spp" "$rr" "$rd" "$tn" "$tm" "$lr" "$ld" "$est" "$dsec" <<'PY'
 import sys, math
 name, res, b, spp, rr, rd, tn, tm, lr, ld, est, dsec = sys.argv[1:]
 rr, rd, tn, tm, lr, ld, est = map(float, (rr, rd, tn, tm, lr, ld, est))
 net = lambda r: math.sqrt(max(0.0, r * r - tn * tn))
 nr, nd = net(rr), net(rd)
-print(f"| {name} | {res} | {b} | {spp} | {rr:.4g} / {nr:.4g} | {nd:.4g} | {nd*nd/(nr*nr):.3f} | {lr:.4f} | {ld:.4f} | "
+print(f"| {name} | {res} | {b} | {float(spp):.0f} | {rr:.4g} / {nr:.4g} | {nd:.4g} | {nd*nd/(nr*nr):.3f} | {lr:.4f} | {ld:.4f} | "
       f"{est:.4f} / {nr/tm:.4f} | {tn/tm:.4f} | {dsec} |")
 PY
     done

@@ -98,6 +98,9 @@ int main(int argc, char** argv) {
     compare->add_option("test", ca.test, "Test image (.exr)")->required();
     compare->add_option("reference", ca.reference, "Reference image (.exr)")->required();
     compare->add_option("--diff", ca.diff, "Write a false-colour difference PNG");
+    compare->add_option("--layer", ca.layer,
+                        "Measure this layer of the test image (its R, G, B and A channels) instead of its RGBA: "
+                        "noisy, even or odd of a denoised render");
     compare->add_flag("--identical", ca.identical,
                       "Only check bit-identity of every channel of every pixel (and the windows): exit 0 if "
                       "identical, 1 if not");

@@ -69,15 +69,45 @@ int compareIdentical(const CompareArgs& a) {
     return n ? 1 : 0;
 }
 
+// The test image, or its layer `name` as RGBA (alpha 1 where the layer has
+// none); an InputError names the layers the file has.
+Image testImage(const CompareArgs& a) {
+    if (a.layer.empty()) return readExr(a.test);
+    ExrContents c = readExrContents(a.test);
+    std::string names;
+    for (const ExrLayer& l : c.layers) {
+        names += (names.empty() ? "" : ", ") + l.name;
+        if (l.name != a.layer) continue;
+        Image out(c.image.width, c.image.height);
+        const size_t channels = l.channels.size(), pixels = out.pixelCount();
+        for (size_t p = 0; p < pixels; ++p) out.rgba[4 * p + 3] = 1.f;
+        std::string found;
+        for (size_t k = 0; k < channels; ++k) {
+            const std::string& ch = l.channels[k];
+            const int i = ch == "R" ? 0 : ch == "G" ? 1 : ch == "B" ? 2 : ch == "A" ? 3 : -1;
+            if (i < 0) continue;
+            found += ch;
+            for (size_t p = 0; p < pixels; ++p) out.rgba[4 * p + size_t(i)] = l.pixels[p * channels + k];
+        }
+        if (found.find('R') == std::string::npos || found.find('G') == std::string::npos ||
+            found.find('B') == std::string::npos)
+            throw InputError(str("--layer ", a.layer, ": layer of ", a.test, " has no R, G and B channels"));
+        return out;
+    }
+    throw InputError(str("--layer ", a.layer, ": ", a.test, " has no such layer (it has: ",
+                         names.empty() ? std::string("none") : names, ")"));
+}
+
 }  // namespace
 
 int runCompare(const CompareArgs& a) {
+    if (!a.layer.empty() && a.identical) throw InputError("--layer and --identical: the identity check reads every layer");
     if (a.identical) {
         if (!a.diff.empty()) throw InputError("--diff and --identical: the identity check writes no image");
         return compareIdentical(a);
     }
     if (!a.diff.empty()) checkWritable(a.diff);
-    Image ia = readExr(a.test), ib = readExr(a.reference);
+    Image ia = testImage(a), ib = readExr(a.reference);
     ImageErrorStats s = compareImages(ia, ib);
     std::printf("rmse %.6g\nrelmse %.6g\nmean_abs_rel_error %.6g\nmean_test %.6g\nmean_reference %.6g\n"
                 "rmse_over_mean %.6g\nlow_frequency_error %.6g\nnonfinite_test %zu\nnonfinite_reference %zu\npixels %zu\n",

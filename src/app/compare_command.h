@@ -11,6 +11,9 @@ struct CompareArgs {
     // Exit 0 when both files hold bit-identical pixels in every channel and
     // the same windows, 1 otherwise (tiled renders against one process).
     bool identical = false;
+    // Measure this layer of the test image (R, G, B, and A where it has
+    // one) instead of its RGBA: `noisy`, the raw beauty of a denoised render.
+    std::string layer;
 };
 
 int runCompare(const CompareArgs& args);
