@@ -52,7 +52,7 @@ bool isDenoiserInput(const ExrLayer& l) {
     return l.name == EvenHalfLayer || l.name == OddHalfLayer || l.name == EmittedEvenLayer || l.name == EmittedOddLayer;
 }
 
-Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads) {
+Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads, std::vector<float>* variances) {
     const size_t pixels = size_t(width) * size_t(height);
     const ExrLayer* even = findLayer(layers, EvenHalfLayer);
     const ExrLayer* odd = findLayer(layers, OddHalfLayer);
@@ -75,7 +75,7 @@ Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, i
     if (const ExrLayer* l = findLayer(layers, "depth")) in.depth = channel(*l, "Z", pixels);
     DenoiseOptions options;
     options.threads = threads;
-    return denoise(in, options);
+    return denoise(in, options, variances);
 }
 
 double predictDenoiseSeconds(int width, int height, const DenoiseShape& shape, int threads) {

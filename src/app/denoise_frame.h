@@ -33,7 +33,10 @@ ExrLayer rgbLayer(const char* name, const Image& img);
 // normal and depth AOV layers among `layers` when present;
 // channels are found by name, in any order. InputError when a half is
 // missing.
-Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads);
+// With `variances`, also the denoised image's estimated noise variance per
+// pixel (denoise()).
+Image denoiseFrame(int width, int height, const std::vector<ExrLayer>& layers, int threads,
+                   std::vector<float>* variances = nullptr);
 
 // What a frame's denoiser input holds besides the halves.
 struct DenoiseShape {

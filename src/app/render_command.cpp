@@ -246,6 +246,20 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
                                  desc.render.aovs.depth};
         options.reserveSeconds = std::min(
             predictDenoiseSeconds(window.width(), window.height(), shape, desc.render.threads), 0.5 * options.timeBudget);
+        // Adaptive sampling weighs each block's noise by what the denoiser
+        // leaves of it (docs/noise.md, "Timed renders").
+        options.denoisedVariance = [threads = desc.render.threads](const FrameHalves& f) {
+            std::vector<ExrLayer> layers = f.aovs;
+            layers.push_back(rgbaLayer(EvenHalfLayer, f.even));
+            layers.push_back(rgbaLayer(OddHalfLayer, f.odd));
+            if (!f.emittedEven.empty()) {
+                layers.push_back(rgbLayer(EmittedEvenLayer, f.emittedEven));
+                layers.push_back(rgbLayer(EmittedOddLayer, f.emittedOdd));
+            }
+            std::vector<float> variances;
+            denoiseFrame(f.even.width, f.even.height, layers, threads, &variances);
+            return variances;
+        };
     }
 
     // Checkpoints: resume from the file when it is there (--resume: it must

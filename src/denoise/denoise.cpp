@@ -774,9 +774,12 @@ bool solveAlphaRegression(double s0, double s1, double s2, const double* t0, con
 // One pixel's estimate is noisy, so it is box-averaged over
 // (2 radius + 1)^2 pixels before the choice, and the one-hot choices are
 // box-averaged again into blending weights: no seams between regions.
+// With `ownWeight`, also the blend's dF/dy per pixel: the weight of the
+// pixel's own value in its output (the candidates' `inverse` in the blend's
+// proportions).
 std::vector<Plane> selectCandidates(const std::vector<std::vector<Plane>>& filtered, const std::vector<Plane>& inverse,
                                     const std::vector<Plane>& clamped, const std::vector<Plane>& variance,
-                                    int radius) {
+                                    int radius, Plane* ownWeight) {
     const size_t candidates = filtered.size(), planes = filtered[0].size();
     const int w = clamped[0].width, h = clamped[0].height;
     std::vector<Plane> risk;
@@ -806,10 +809,16 @@ std::vector<Plane> selectCandidates(const std::vector<std::vector<Plane>>& filte
     });
     for (Plane& c : choice) c = boxAverage(c, radius);
     std::vector<Plane> out(planes, Plane(w, h, 0));
+    if (ownWeight) *ownWeight = Plane(w, h, 0);
     forEachRow(h, [&](int y) {
         for (int x = 0; x < w; ++x) {
             float total = 0;
             for (size_t j = 0; j < candidates; ++j) total += choice[j].at(x, y);
+            if (ownWeight) {
+                float own = 0;
+                for (size_t j = 0; j < candidates; ++j) own += choice[j].at(x, y) * inverse[j].at(x, y);
+                ownWeight->at(x, y) = own / total;
+            }
             for (size_t c = 0; c < planes; ++c) {
                 float v = 0;
                 for (size_t j = 0; j < candidates; ++j) v += choice[j].at(x, y) * filtered[j][c].at(x, y);
@@ -884,7 +893,7 @@ void checkInput(const DenoiseInput& in, const DenoiseOptions& options) {
 
 // The whole algorithm on one image (its emitted part, if any, ignored);
 // `in` already checked.
-Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options) {
+Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options, std::vector<float>* variances) {
     const int w = in.width, h = in.height;
     const size_t pixels = size_t(w) * size_t(h);
     Image out(w, h);
@@ -1118,9 +1127,41 @@ Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options) {
                         inverse[candidates].at(x, y) = ok ? 0.5f * (ha + hb) : inverse[regressionAt].at(x, y);
                     }
         });
+        // The variance estimate alone takes the selection's path, with one candidate too.
+        Plane ownWeight;
         std::vector<Plane> selected =
-            filters == 1 ? std::move(filtered[0])
-                            : selectCandidates(filtered, inverse, clamped, variance, options.selectionRadius);
+            filters == 1 && !variances
+                ? std::move(filtered[0])
+                : selectCandidates(filtered, inverse, clamped, variance, options.selectionRadius,
+                                   variances ? &ownWeight : nullptr);
+        // The output's noise variance: the noisy mean's (half a half's, step
+        // 2) times the pixel's own weight in its output, the variance of a
+        // mean of equally noisy values with weights 0 and 1; plus that of the
+        // restored local means, a Gaussian average of the noise (1 / (4 pi
+        // sigma^2) of it), whose noise at scales beyond the Gaussian is the
+        // noisy image's own. Both average the same noise over similar areas,
+        // so the sum counts their overlap twice: on the synthetic frame of the
+        // tests it is 1.4-1.6x the noise left away from edges, and in renders
+        // it keeps adaptive sampling from starving smooth regions, whose
+        // low-frequency noise the restored means keep (cloud_sun, 16 s: the
+        // own weight alone raised the denoised low-frequency error by a
+        // tenth; BENCHMARKS.md). The filter's bias is not in it. (The
+        // blend's SURE was tried as this estimate: over an 8x8 block its
+        // noise, and its bias from the weights' dependence on the values,
+        // left it negative in flat regions.)
+        if (variances) {
+            const float restored = options.restoreSigma > 0
+                                       ? 1.f / (4.f * 3.14159265f * options.restoreSigma * options.restoreSigma)
+                                       : 0.f;
+            variances->assign(pixels, 0.f);
+            forEachRow(h, [&](int y) {
+                for (int x = 0; x < w; ++x) {
+                    float noise = 0;
+                    for (size_t c = 0; c < 3; ++c) noise += 0.5f * variance[c].at(x, y);
+                    (*variances)[size_t(y) * size_t(w) + size_t(x)] = noise * (ownWeight.at(x, y) + restored);
+                }
+            });
+        }
 
         // The noisy image's local means, restored: NL-means averages each
         // pixel with similar ones wherever they are in the search window,
@@ -1163,7 +1204,7 @@ Image denoiseWhole(const DenoiseInput& in, const DenoiseOptions& options) {
 
 }  // namespace
 
-Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
+Image denoise(const DenoiseInput& in, const DenoiseOptions& options, std::vector<float>* variances) {
     checkInput(in, options);
     const size_t pixels = size_t(in.width) * size_t(in.height);
     // Nothing emitted anywhere (or no emitted part): the whole image as one,
@@ -1171,7 +1212,7 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
     auto zero = [](const Color& c) { return c.x == 0 && c.y == 0 && c.z == 0; };
     if (std::all_of(in.emittedA.begin(), in.emittedA.end(), zero) &&
         std::all_of(in.emittedB.begin(), in.emittedB.end(), zero))
-        return denoiseWhole(in, options);
+        return denoiseWhole(in, options, variances);
     // The scattered light (each half minus its emitted part) and the emitted
     // part, each denoised on its own with the same alpha and features; the
     // image is their sum, its alpha the scattered part's.
@@ -1188,7 +1229,7 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
     // the noisy image's with 4 pixels, 1.07x with 2, and 4 % less MSE).
     DenoiseOptions scatteredOptions = options;
     scatteredOptions.restoreSigma = 0.5f * options.restoreSigma;
-    Image out = denoiseWhole(scattered, scatteredOptions);
+    Image out = denoiseWhole(scattered, scatteredOptions, variances);
     // The emitted part is filtered only where its noise counts: the
     // marchers integrate emission along the camera ray nearly noise-free
     // (the sample plume: 2 % of the image's half-difference variance), and
@@ -1205,12 +1246,17 @@ Image denoise(const DenoiseInput& in, const DenoiseOptions& options) {
         for (size_t p = 0; p < pixels; ++p) {
             const Color e = 0.5f * (in.emittedA[p] + in.emittedB[p]);
             for (int c = 0; c < 3; ++c) out.rgba[4 * p + size_t(c)] += e[c];
+            // The emitted mean's own variance, (A - B)^2 / 4 per channel.
+            if (variances) (*variances)[p] += 0.25f * lengthSquared(in.emittedA[p] - in.emittedB[p]);
         }
         return out;
     }
-    const Image e = denoiseWhole(emitted, options);
-    for (size_t p = 0; p < out.pixelCount(); ++p)
+    std::vector<float> emittedVariances;
+    const Image e = denoiseWhole(emitted, options, variances ? &emittedVariances : nullptr);
+    for (size_t p = 0; p < out.pixelCount(); ++p) {
         for (int c = 0; c < 3; ++c) out.rgba[4 * p + size_t(c)] += e.rgba[4 * p + size_t(c)];
+        if (variances) (*variances)[p] += emittedVariances[p];
+    }
     return out;
 }
 

@@ -95,6 +95,13 @@ struct DenoiseOptions {
 // neighbours; a feature by "nothing met"). Throws std::invalid_argument when
 // a vector's size is not width*height (or not empty where that is allowed),
 // on a negative size and on options out of range.
-Image denoise(const DenoiseInput& in, const DenoiseOptions& options = {});
+// With `variances`, also each pixel's estimated noise variance in the
+// output (RGB summed, width*height entries): the noisy mean's variance (from
+// the halves, step 2) times the weight of the pixel's own value in its
+// output, plus the variance of the local means it restores, plus the
+// emitted part's. The filter's bias is not in it. Adaptive
+// sampling weighs a block's noise by what the denoiser leaves of it
+// (docs/noise.md, "Timed renders").
+Image denoise(const DenoiseInput& in, const DenoiseOptions& options = {}, std::vector<float>* variances = nullptr);
 
 }  // namespace vdbmarch

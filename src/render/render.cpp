@@ -298,17 +298,42 @@ struct PixelTimes {
     std::vector<int> samples;
 };
 
+// What the denoiser leaves of each block's noise, from a denoised frame's
+// estimated variance per pixel (`denoised`): K_b = the block's summed pixel
+// variance over its summed denoised variance, at least 1 and at most
+// MaxDenoiserGain.
+constexpr double MaxDenoiserGain = 1000;
+std::vector<double> denoiserGains(const PixelSums& frame, const std::vector<float>& denoised, int ww, int wh) {
+    const int bx = (ww + NoiseBlock - 1) / NoiseBlock, by = (wh + NoiseBlock - 1) / NoiseBlock;
+    std::vector<double> noise(size_t(bx) * size_t(by), 0.0), error(noise.size(), 0.0);
+    for (int y = 0; y < wh; ++y)
+        for (int x = 0; x < ww; ++x) {
+            const size_t p = size_t(y) * size_t(ww) + size_t(x);
+            const size_t b = size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock);
+            Color mean, var;
+            if (pixelNoise(frame.L[p], frame.oddL[p], 0, frame.samplesOf(p), mean, var))
+                noise[b] += double(var.x) + double(var.y) + double(var.z);
+            if (std::isfinite(denoised[p])) error[b] += std::max(0.0, double(denoised[p]));
+        }
+    std::vector<double> gain(noise.size(), 1.0);
+    for (size_t b = 0; b < gain.size(); ++b)
+        gain[b] = noise[b] >= error[b] * MaxDenoiserGain ? MaxDenoiserGain : std::max(1.0, noise[b] / error[b]);
+    return gain;
+}
+
 // Adaptive sampling of a timed render (render.adaptive, docs/noise.md) at a
 // check after n samples, with `secondsLeft` of camera time left (summed over
 // the threads). Each block has s_b and t_b, its pixels' measured seconds
-// per sample. The allocation n_b = k s_b / sqrt(t_b) minimises the image's
-// MSE, sum_b s_b^2 / n_b, for the time sum_b t_b n_b; k is the water level
+// per sample, and where the render is denoised K_b (`gains`, empty: 1), the
+// factor by which the denoiser divides its variance. The allocation n_b = k s_b /
+// sqrt(K_b t_b) minimises the image's MSE, sum_b s_b^2 / (K_b n_b), for the
+// time sum_b t_b n_b; k is the water level
 // at which the still-sampling blocks' targets take up the time left, and a
 // block whose count has reached its target stops. The time left is taken a
 // fifth larger than predicted, so that a wrong prediction leaves a block
 // sampling rather than stopping it early. True when every pixel stopped.
-bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelTimes& times, int ww, int wh, int n,
-                       double secondsLeft) {
+bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelTimes& times,
+                       const std::vector<double>& gains, int ww, int wh, int n, double secondsLeft) {
     NoiseBlocks blocks;
     if (!measureNoiseBlocks(sums, open, ww, wh, n, blocks)) return false;
     const size_t nb = blocks.sigma.size();
@@ -339,7 +364,7 @@ bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelT
         if (!active[b] || timed[b] <= 0) continue;
         allocated[b] = 1;
         t[b] = std::max(seconds[b] / timed[b], 0.01 * meanTime);
-        a[b] = blocks.sigma[b] / std::sqrt(t[b]);
+        a[b] = blocks.sigma[b] / std::sqrt(t[b] * (gains.empty() ? 1.0 : gains[b]));
     }
     // The water level: the time the active blocks' targets take beyond n,
     // sum_b count_b t_b max(0, k a_b - n), equals the time left.
@@ -748,6 +773,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
         const double budget = options.timeBudget - std::max(options.reserveSeconds, 0.0);
         double perSample = 0;  // the camera part of one sample per pixel, last measured
         double cameraSeconds = 0;  // the sweeps' camera time so far (wall)
+        std::vector<double> gains;      // the denoiser's per block, last measured
+        double lastDenoiseSeconds = -1;
         auto photonsBeforeSample = [&](int sample) {
             const int pass = photonPasses.passOf(sample);
             return pass != illumination->photonPass && photonPasses.needsWork(pass) ? firstIlluminationSeconds : 0.0;
@@ -787,8 +814,25 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                 // threads' measured pixel seconds per wall second.
                 double pixelSeconds = 0;
                 for (double t : times.seconds) pixelSeconds += t;
+                // Where the frame is denoised, the denoiser's gain per block,
+                // measured again at a check while a denoise costs at most
+                // DenoiseCheckShare of the time left (the first expected to
+                // take what the render keeps back for the final one).
+                constexpr double DenoiseCheckShare = 0.02;
+                const double expected = lastDenoiseSeconds >= 0 ? lastDenoiseSeconds : options.reserveSeconds;
+                if (options.denoisedVariance && expected <= DenoiseCheckShare * (budget * 0.98 - elapsed)) {
+                    const auto d0 = std::chrono::steady_clock::now();
+                    PixelSums frame = sums;
+                    if (open.pass >= 0) frame.fold(open);
+                    FrameHalves halves{frame.evenHalf(ww, wh), frame.oddHalf(ww, wh), frame.emittedHalf(ww, wh, false),
+                                       frame.emittedHalf(ww, wh, true), aovLayers(aovs, aovSums, frame)};
+                    const std::vector<float> denoised = options.denoisedVariance(halves);
+                    if (denoised.size() == pixels) gains = denoiserGains(frame, denoised, ww, wh);
+                    lastDenoiseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+                    elapsed += lastDenoiseSeconds;
+                }
                 const double left = (budget * 0.98 - elapsed) * (cameraSeconds > 0 ? pixelSeconds / cameraSeconds : 0.0);
-                if (timedAdaptiveStep(sums, open, times, ww, wh, spp, left)) break;
+                if (timedAdaptiveStep(sums, open, times, gains, ww, wh, spp, left)) break;
             }
             // At least two samples where the halves are kept: the denoiser
             // needs both (a one-sample render is written noisy).

@@ -32,6 +32,14 @@ struct CheckpointHooks {
     const RenderCheckpoint* resume = nullptr;
 };
 
+// A frame as the denoiser takes it, at a check of a timed render: the two
+// half renders (RGBA), their emitted parts (empty without them) and the AOV
+// layers (the features).
+struct FrameHalves {
+    Image even, odd, emittedEven, emittedOdd;
+    std::vector<ExrLayer> aovs;
+};
+
 struct RenderOptions {
     bool progress = false;  // progress bar on stderr
     // > 0: render whole sweeps of one sample per pixel until this many
@@ -55,6 +63,11 @@ struct RenderOptions {
     std::optional<CheckpointHooks> checkpoint;
     // Keep the two half renders in the result (the denoiser's input).
     bool keepHalves = false;
+    // Where the render is denoised: the denoised image's estimated noise
+    // variance per pixel of a frame (the window's pixels, row-major).
+    // Adaptive sampling in a timed render then weighs each block's noise by
+    // what the denoiser leaves of it (docs/noise.md, "Timed renders").
+    std::function<std::vector<float>(const FrameHalves&)> denoisedVariance;
     // Also sum PathRadiance::emitted per pixel in halves (E, oddE), which the
     // denoiser takes apart from the scattered light (docs/denoise.md).
     bool keepEmitted = false;

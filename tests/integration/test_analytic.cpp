@@ -321,6 +321,33 @@ TEST(TimedAdaptive, AgreesWithEvenSampling) {
     EXPECT_GT(ma, 0.05);
 }
 
+// Where the render is denoised, a block's noise counts by what the
+// denoiser leaves of it: with a denoised variance of 0 in the slab's first
+// column of blocks (the denoiser's gain capped at 1000) and larger than the
+// noise in the second (gain 1), the first stops far earlier.
+TEST(TimedAdaptive, BlocksTheDenoiserCleansGetFewerSamples) {
+    auto scene = buildScene(halfSlabScene({}));
+    RenderOptions timed;
+    timed.timeBudget = 1.0;
+    int calls = 0;
+    timed.denoisedVariance = [&](const FrameHalves& f) {
+        ++calls;
+        std::vector<float> variances(f.even.pixelCount());
+        for (int y = 0; y < f.even.height; ++y)
+            for (int x = 8; x < f.even.width; ++x) variances[size_t(y) * size_t(f.even.width) + size_t(x)] = 1e6f;
+        return variances;
+    };
+    const RenderResult r = renderImage(*scene, timed);
+    ASSERT_GT(r.spp, 24) << "too slow a machine for a second of rendering to pass the first checks";
+    EXPECT_GT(calls, 0);
+    const ExrLayer* samples = samplesLayer(r);
+    ASSERT_NE(samples, nullptr);
+    double first = 0, second = 0;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) (x < 8 ? first : second) += samples->pixels[size_t(y) * 32 + size_t(x)];
+    EXPECT_LT(first, 0.5 * second) << "first column " << first / 128 << " spp, second " << second / 128;
+}
+
 // render.adaptive = false: every pixel gets the same samples.
 TEST(TimedAdaptive, OffSamplesEvenly) {
     auto scene = buildScene(halfSlabScene({"render.adaptive=false"}));
