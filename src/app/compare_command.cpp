@@ -73,29 +73,24 @@ int compareIdentical(const CompareArgs& a) {
 // none); an InputError names the layers the file has.
 Image testImage(const CompareArgs& a) {
     if (a.layer.empty()) return readExr(a.test);
-    ExrContents c = readExrContents(a.test);
-    std::string names;
-    for (const ExrLayer& l : c.layers) {
-        names += (names.empty() ? "" : ", ") + l.name;
-        if (l.name != a.layer) continue;
-        Image out(c.image.width, c.image.height);
-        const size_t channels = l.channels.size(), pixels = out.pixelCount();
-        for (size_t p = 0; p < pixels; ++p) out.rgba[4 * p + 3] = 1.f;
-        std::string found;
-        for (size_t k = 0; k < channels; ++k) {
-            const std::string& ch = l.channels[k];
-            const int i = ch == "R" ? 0 : ch == "G" ? 1 : ch == "B" ? 2 : ch == "A" ? 3 : -1;
-            if (i < 0) continue;
-            found += ch;
-            for (size_t p = 0; p < pixels; ++p) out.rgba[4 * p + size_t(i)] = l.pixels[p * channels + k];
-        }
-        if (found.find('R') == std::string::npos || found.find('G') == std::string::npos ||
-            found.find('B') == std::string::npos)
-            throw InputError(str("--layer ", a.layer, ": layer of ", a.test, " has no R, G and B channels"));
-        return out;
+    const ExrContents c = readExrContents(a.test);
+    const ExrLayer* l = findLayer(c.layers, a.layer);
+    if (!l) {
+        std::string names;
+        for (const ExrLayer& other : c.layers) names += (names.empty() ? "" : ", ") + other.name;
+        throw InputError(str("--layer ", a.layer, ": ", a.test, " has no such layer (it has: ",
+                             names.empty() ? std::string("none") : names, ")"));
     }
-    throw InputError(str("--layer ", a.layer, ": ", a.test, " has no such layer (it has: ",
-                         names.empty() ? std::string("none") : names, ")"));
+    Image out(c.image.width, c.image.height);
+    const size_t pixels = out.pixelCount();
+    const char* names[] = {"R", "G", "B", "A"};
+    for (size_t k = 0; k < 4; ++k) {
+        const std::vector<float> v = layerChannel(*l, names[k], pixels);
+        if (v.empty() && k < 3 && pixels > 0)
+            throw InputError(str("--layer ", a.layer, ": the layer of ", a.test, " has no R, G and B channels"));
+        for (size_t p = 0; p < pixels; ++p) out.rgba[4 * p + k] = v.empty() ? 1.f : v[p];
+    }
+    return out;
 }
 
 }  // namespace

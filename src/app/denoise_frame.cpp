@@ -13,19 +13,10 @@ namespace vdbmarch {
 
 namespace {
 
-const ExrLayer* findLayer(const std::vector<ExrLayer>& layers, const char* name) {
-    for (const ExrLayer& l : layers)
-        if (l.name == name) return &l;
-    return nullptr;
-}
-
-// Channel `c` of every pixel of a layer (the file stores channels in name order).
+// Channel `c` of every pixel of a layer; InputError when it has none.
 std::vector<float> channel(const ExrLayer& l, const char* c, size_t pixels) {
-    const auto it = std::find(l.channels.begin(), l.channels.end(), c);
-    if (it == l.channels.end()) throw InputError(str("layer '", l.name, "' has no channel ", c));
-    const size_t k = size_t(it - l.channels.begin()), n = l.channels.size();
-    std::vector<float> out(pixels);
-    for (size_t p = 0; p < pixels; ++p) out[p] = l.pixels[p * n + k];
+    std::vector<float> out = layerChannel(l, c, pixels);
+    if (out.empty() && pixels > 0) throw InputError(str("layer '", l.name, "' has no channel ", c));
     return out;
 }
 

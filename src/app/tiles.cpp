@@ -220,9 +220,7 @@ MergedTiles mergePasses(const std::vector<Tile>& parts) {
         pass.samples = samples;
         for (const bool odd : {false, true}) {
             const std::string name = str("pass", p, odd ? "odd" : "");
-            const ExrLayer* layer = nullptr;
-            for (const ExrLayer& l : t.contents.layers)
-                if (l.name == name) layer = &l;
+            const ExrLayer* layer = findLayer(t.contents.layers, name);
             if (!layer || layer->channels != std::vector<std::string>{"B", "G", "R", "T"} || samples <= 0)
                 throw InputError(str(t.path, ": damaged part: no layer ", name, " (B, G, R, T) or no sample count for it"));
             std::vector<ColorSum>& L = odd ? pass.oddL : pass.L;

@@ -338,6 +338,21 @@ ExrContents readExrContents(const std::string& path) {
     return withInputFile(path, [&](Imf::InputFile& in) { return readContents(path, in, true); });
 }
 
+const ExrLayer* findLayer(const std::vector<ExrLayer>& layers, const std::string& name) {
+    for (const ExrLayer& l : layers)
+        if (l.name == name) return &l;
+    return nullptr;
+}
+
+std::vector<float> layerChannel(const ExrLayer& layer, const std::string& c, size_t pixels) {
+    const auto it = std::find(layer.channels.begin(), layer.channels.end(), c);
+    if (it == layer.channels.end()) return {};
+    const size_t k = size_t(it - layer.channels.begin()), n = layer.channels.size();
+    std::vector<float> out(pixels);
+    for (size_t p = 0; p < pixels; ++p) out[p] = layer.pixels[p * n + k];
+    return out;
+}
+
 StringAttributes readExrStringAttributes(const std::string& path) {
     return withInputFile(path, [](Imf::InputFile& in) { return stringAttributes(in.header()); });
 }

@@ -61,6 +61,12 @@ struct ExrContents {
 };
 ExrContents readExrContents(const std::string& path);
 
+// The layer named `name` among `layers`, or null.
+const ExrLayer* findLayer(const std::vector<ExrLayer>& layers, const std::string& name);
+// Channel `c` of each of a layer's `pixels` pixels (a file stores its
+// channels in name order); empty when the layer has no such channel.
+std::vector<float> layerChannel(const ExrLayer& layer, const std::string& c, size_t pixels);
+
 // All string attributes of the header, sorted by name.
 StringAttributes readExrStringAttributes(const std::string& path);
 

@@ -229,13 +229,16 @@ struct NoiseBlocks {
     std::vector<double> sigma;
     std::vector<int> count;  // pixels in the block
     NoiseEstimate image;
+    NoiseBlocks() = default;
+    // The blocks of a ww x wh window, zeroed.
+    NoiseBlocks(int ww, int wh)
+        : bx((ww + NoiseBlock - 1) / NoiseBlock), by((wh + NoiseBlock - 1) / NoiseBlock),
+          sigma(size_t(bx) * size_t(by), 0.0), count(sigma.size(), 0) {}
+    size_t size() const { return sigma.size(); }
     size_t of(int x, int y) const { return size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock); }
 };
 bool measureNoiseBlocks(const PixelSums& sums, const PhotonPassSums& open, int ww, int wh, int n, NoiseBlocks& out) {
-    out.bx = (ww + NoiseBlock - 1) / NoiseBlock;
-    out.by = (wh + NoiseBlock - 1) / NoiseBlock;
-    out.sigma.assign(size_t(out.bx) * size_t(out.by), 0.0);
-    out.count.assign(out.sigma.size(), 0);
+    out = NoiseBlocks(ww, wh);
     NoiseTotals totals;
     for (int y = 0; y < wh; ++y)
         for (int x = 0; x < ww; ++x) {
@@ -304,12 +307,11 @@ struct PixelTimes {
 // MaxDenoiserGain.
 constexpr double MaxDenoiserGain = 1000;
 std::vector<double> denoiserGains(const PixelSums& frame, const std::vector<float>& denoised, int ww, int wh) {
-    const int bx = (ww + NoiseBlock - 1) / NoiseBlock, by = (wh + NoiseBlock - 1) / NoiseBlock;
-    std::vector<double> noise(size_t(bx) * size_t(by), 0.0), error(noise.size(), 0.0);
+    const NoiseBlocks layout(ww, wh);
+    std::vector<double> noise(layout.size(), 0.0), error(layout.size(), 0.0);
     for (int y = 0; y < wh; ++y)
         for (int x = 0; x < ww; ++x) {
-            const size_t p = size_t(y) * size_t(ww) + size_t(x);
-            const size_t b = size_t(y / NoiseBlock) * size_t(bx) + size_t(x / NoiseBlock);
+            const size_t p = size_t(y) * size_t(ww) + size_t(x), b = layout.of(x, y);
             Color mean, var;
             if (pixelNoise(frame.L[p], frame.oddL[p], 0, frame.samplesOf(p), mean, var))
                 noise[b] += double(var.x) + double(var.y) + double(var.z);
@@ -336,7 +338,7 @@ bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelT
                        const std::vector<double>& gains, int ww, int wh, int n, double secondsLeft) {
     NoiseBlocks blocks;
     if (!measureNoiseBlocks(sums, open, ww, wh, n, blocks)) return false;
-    const size_t nb = blocks.sigma.size();
+    const size_t nb = blocks.size();
     std::vector<double> seconds(nb, 0.0), timed(nb, 0.0);
     std::vector<char> active(nb, 0);
     for (int y = 0; y < wh; ++y)
@@ -347,22 +349,22 @@ bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelT
             if (sums.convergedAt[p] == 0) active[b] = 1;
         }
     // Blocks without a measured time (a resumed render's pixels that have
-    // not sampled since) keep sampling; a block's time is floored at a
-    // hundredth of the mean. A block of no noise at all (the background)
-    // has target 0: it stops, as it does towards a noise target.
+    // not sampled since) keep sampling, outside the allocation; a block's
+    // time is floored at a hundredth of the mean. A block of no noise at all
+    // (the background) has target 0: it stops, as it does towards a noise
+    // target.
     double meanTime = 0, pixelsIn = 0;
     for (size_t b = 0; b < nb; ++b) {
-        if (!active[b] || timed[b] <= 0) continue;
+        active[b] = active[b] && timed[b] > 0;
+        if (!active[b]) continue;
         meanTime += seconds[b] / timed[b] * blocks.count[b];
         pixelsIn += blocks.count[b];
     }
     if (pixelsIn == 0 || !(meanTime > 0)) return false;
     meanTime /= pixelsIn;
-    std::vector<char> allocated(nb, 0);
     std::vector<double> a(nb, 0.0), t(nb, 0.0);
     for (size_t b = 0; b < nb; ++b) {
-        if (!active[b] || timed[b] <= 0) continue;
-        allocated[b] = 1;
+        if (!active[b]) continue;
         t[b] = std::max(seconds[b] / timed[b], 0.01 * meanTime);
         a[b] = blocks.sigma[b] / std::sqrt(t[b] * (gains.empty() ? 1.0 : gains[b]));
     }
@@ -372,7 +374,7 @@ bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelT
     auto timeAt = [&](double k) {
         double sum = 0;
         for (size_t b = 0; b < nb; ++b)
-            if (allocated[b]) sum += blocks.count[b] * t[b] * std::max(0.0, k * a[b] - n);
+            if (active[b]) sum += blocks.count[b] * t[b] * std::max(0.0, k * a[b] - n);
         return sum;
     };
     double lo = 0, hi = 1;
@@ -383,7 +385,7 @@ bool timedAdaptiveStep(PixelSums& sums, const PhotonPassSums& open, const PixelT
     }
     std::vector<double> target(nb, std::numeric_limits<double>::infinity());
     for (size_t b = 0; b < nb; ++b)
-        if (allocated[b]) target[b] = hi * a[b];
+        if (active[b]) target[b] = hi * a[b];
     return stopBlocksAt(sums, blocks, target, ww, wh, n);
 }
 
@@ -618,7 +620,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
                             const uint64_t pixel = uint64_t(y) * uint64_t(w) + uint64_t(x);  // in the frame
                             const size_t local = size_t(y - window.y0) * size_t(ww) + size_t(x - window.x0);
                             if (adaptive && sums.convergedAt[local] > 0) continue;  // stopped sampling
-                            const auto t0 = std::chrono::steady_clock::now();
+                            const auto t0 = timedAdaptive ? std::chrono::steady_clock::now()
+                                                          : std::chrono::steady_clock::time_point();
                             for (int s = s0; s < s1; ++s)
                                 addCameraSample(scene, *marcher, ctx, x, y, pixel, s, local, open, aovSums);
                             if (timedAdaptive) {

@@ -279,8 +279,11 @@ TEST(TimedAdaptive, BlocksOfNoNoiseStopAtTheFirstCheck) {
         for (int x = 0; x < 32; ++x) {
             const float n = samples->pixels[size_t(y) * 32 + size_t(x)];
             EXPECT_EQ(n, samples->pixels[size_t(y / 8 * 8) * 32 + size_t(x / 8 * 8)]);
-            if (x >= 16) EXPECT_EQ(n, 16.f) << x << ", " << y;
-            if (x < 16) EXPECT_GT(n, 16.f) << x << ", " << y;
+            if (x >= 16) {
+                EXPECT_EQ(n, 16.f) << x << ", " << y;
+            } else {
+                EXPECT_GT(n, 16.f) << x << ", " << y;
+            }
         }
     EXPECT_LT(r.meanSpp, double(r.spp));
     EXPECT_EQ(*std::max_element(samples->pixels.begin(), samples->pixels.end()), float(r.spp));
