@@ -5,6 +5,12 @@
 // differs between RGB channels are tracked one channel per path (three
 // paths per sample).
 //
+// A path cannot find a delta light through refracting glass (shadow rays
+// cannot bend): where a scene has such caustics, the photons flagged
+// caustic give them at the camera path's first medium vertex (eq. 4, the
+// progressive passes' radius), as they do at the guided marcher's L_i
+// samples; the paths give all the rest.
+//
 // Guided path tracing is the same loop with the radiance cache as its guide
 // (cache_path_guide.h): free flights, and with render.product_sampling
 // directions, drawn towards where the cache says the light is.
@@ -18,11 +24,26 @@ namespace vdbmarch {
 
 namespace {
 
+// L_caustic of eq. 4 over the current photon pass's caustic photons.
+class CausticPhotons final : public InScatteredLight {
+public:
+    explicit CausticPhotons(const Illumination& il) : mIl(il) {}
+    Color at(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const override {
+        if (!mIl.indirect) return Color(0);
+        return mIl.indirect->estimateLi(x, wo, size_t(mIl.k), [&](float c) { return phase.eval(c); }, nullptr,
+                                        mIl.radiusScale);
+    }
+
+private:
+    const Illumination& mIl;
+};
+
 class ReferenceTracer final : public Estimator {
 public:
     ReferenceTracer(const Scene& s, std::shared_ptr<const Illumination> il = nullptr)
         : mScene(s), mChromatic(hasChromaticExtinction(s)), mIllumination(std::move(il)) {
         if (mIllumination && mIllumination->cache) mGuide = makeCachePathGuide(s, *mIllumination->cache);
+        if (mIllumination && mIllumination->causticsOnly) mCaustics = std::make_unique<CausticPhotons>(*mIllumination);
     }
 
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
@@ -30,6 +51,7 @@ public:
         const int region = regionAtRayStart(mScene, cameraRay);
         PathState start;
         start.guide = mGuide.get();
+        start.firstVertexLight = mCaustics.get();
         if (!mChromatic) return tracePath(ctx, cameraRay, region, -1, rng, start);
         PathRadiance out{Color(0), 0.f, Color(0), Color(0)};
         for (int c = 0; c < 3; ++c) {
@@ -47,12 +69,13 @@ private:
     const bool mChromatic;
     std::shared_ptr<const Illumination> mIllumination;  // keeps the guide's cache alive
     std::unique_ptr<PathGuide> mGuide;
+    std::unique_ptr<InScatteredLight> mCaustics;  // null where no caustic photons are traced
 };
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination>) {
-    return std::make_unique<ReferenceTracer>(scene);
+std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
+    return std::make_unique<ReferenceTracer>(scene, std::move(il));
 }
 
 std::unique_ptr<Estimator> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {

@@ -36,7 +36,8 @@ namespace {
 // The photons L_i takes beside shadow rays (see IlluminationRequest).
 bool wantedInMap(const Photon& p, const IlluminationRequest& rq) {
     if (rq.exceptConnected && p.isConnected()) return false;
-    return rq.causticsOnly ? p.isCaustic() || (p.isFromPointLight() && !p.isDirect()) : !p.isDirect();
+    return rq.causticsOnly ? p.isCaustic() || (rq.pointLightsByPhotons && p.isFromPointLight() && !p.isDirect())
+                           : !p.isDirect();
 }
 
 std::unique_ptr<PhotonMap> indirectMap(const std::vector<Photon>& photons, const IlluminationRequest& rq) {
@@ -68,6 +69,7 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
     il.k = rq.photons.k;
     il.li = scene.desc.render.li;
     il.pointLightsByPhotons = rq.pointLightsByPhotons;
+    il.causticsOnly = rq.indirect && rq.causticsOnly;
     if (!sceneScatters(scene)) return il;  // no L_i anywhere: nothing to trace or cache
     bool needCache = rq.cache;
     if (needCache && !rq.cacheFile.empty()) {
@@ -183,11 +185,27 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     rq.cacheSettings = scene.desc.cache;
     rq.renderSeed = rs.seed;
     rq.force = options.force;
-    if (method == Method::Reference) {  // traces every path itself; render.li does not apply
+    const bool bendingGlass = hasBendingGlass(scene);
+    bool deltaLight = false, pointLight = false;
+    for (const Light& l : scene.lights) {
+        deltaLight = deltaLight || l.isDelta();
+        pointLight = pointLight || l.isPointLike();
+    }
+    // Caustics of delta lights through refracting glass, which no path can
+    // find, come from the caustic photons; through glass spheres, sphere
+    // caustic connections find them where Scene::deltaLightCaustics holds.
+    auto requestCaustics = [&] {
+        rq.indirect = bendingGlass && deltaLight && !scene.deltaLightCaustics;
+        rq.causticsOnly = true;
+        rq.exceptConnected = scene.deltaLightCaustics;
+    };
+    if (method == Method::Reference) {  // paths, and photons for what they cannot find; render.li does not apply
         if (!options.cacheFile.empty()) warn(str(options.cacheFile, ": the reference tracer does not read a cache; ignored"));
+        requestCaustics();
         return rq;
     }
-    if (method == Method::GuidedPath) {  // the cache alone, as the paths' guide
+    if (method == Method::GuidedPath) {  // the cache, as the paths' guide
+        requestCaustics();
         rq.cache = true;
         rq.cacheFile = options.cacheFile;
         if (rs.productSampling) rq.cacheSettings.directionLobes = true;  // guided directions
@@ -210,19 +228,10 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // Point and spot lights are the exception: next-event estimation at
     // path vertices near them has unbounded variance (1/d^2), so photons
     // carry their multiply scattered light too.
-    const bool bendingGlass = hasBendingGlass(scene);
-    bool deltaLight = false, pointLight = false;
-    for (const Light& l : scene.lights) {
-        deltaLight = deltaLight || l.isDelta();
-        pointLight = pointLight || l.isPointLike();
-    }
     if (rs.li == LiSource::Photons) rq.indirect = rs.maxDepth > 1 || bendingGlass;
     if (rs.li == LiSource::Path) {
-        // Caustics of delta lights through glass spheres come from sphere
-        // caustic connections where Scene::deltaLightCaustics holds.
-        rq.indirect = (bendingGlass && deltaLight && !scene.deltaLightCaustics) || (pointLight && rs.maxDepth > 1);
-        rq.causticsOnly = true;
-        rq.exceptConnected = scene.deltaLightCaustics;
+        requestCaustics();
+        rq.indirect = rq.indirect || (pointLight && rs.maxDepth > 1);
         rq.pointLightsByPhotons = pointLight && rq.indirect;
     }
     return rq;

@@ -51,6 +51,9 @@ struct Illumination {
     std::unique_ptr<RadianceCache> cache;  // null unless requested
     int k = 50;                            // photons per estimate
     bool pointLightsByPhotons = false;     // "path": indirect carries point and spot lights' scattered light
+    // indirect holds only caustic photons (and those of pointLightsByPhotons):
+    // a path tracer adds them at its first medium vertex.
+    bool causticsOnly = false;
     LiSource li = LiSource::Photons;
     bool cacheLoaded = false;  // from a baked file: never refined
     // Progressive photon pass the map belongs to, and its gather radius

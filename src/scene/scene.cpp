@@ -95,27 +95,21 @@ void findGlassSpheres(Scene& scene) {
 }
 
 // A path tracer cannot reach a delta light through refracting glass, except
-// through glass spheres (Scene::deltaLightCaustics): a render by one says
-// what it misses.
+// through glass spheres (Scene::deltaLightCaustics). In media the caustic
+// photons give that light (docs/method.md, the reference path tracer); on
+// diffuse surfaces nothing does: a render by one says what it misses.
 void warnOfMissedCaustics(const Scene& scene) {
     const SceneDesc& desc = scene.desc;
     if (!isPathTracer(desc.render.method) || scene.deltaLightCaustics) return;
-    bool deltaLight = false, glassWithMedium = false;
+    bool deltaLight = false, diffuse = false;
     for (const Light& l : scene.lights) deltaLight = deltaLight || l.isDelta();
-    for (const auto& s : desc.surfaces)
-        glassWithMedium = glassWithMedium || (s.material.type == MaterialDesc::Type::Dielectric &&
-                                              s.material.ior != 1.f && !s.interior.empty());
-    if (!deltaLight) return;
-    if (glassWithMedium)
-        warn(str(desc.file, ": a delta light (point, spot, directional or collimated_quad) cannot be seen through "
-                            "glass by a unidirectional path tracer: the medium inside the glass gets none of its "
-                            "light in the reference, except through glass spheres with render.sphere_caustics; use "
-                            "sphere lights where the reference must converge"));
-    else if (hasBendingGlass(scene))
-        warn(str(desc.file, ": the caustics of a delta light (point, spot, directional or collimated_quad) "
-                            "through refracting glass are missing from a unidirectional path tracer, except "
-                            "through glass spheres with render.sphere_caustics (docs/method.md, \"Caustics through "
-                            "glass spheres\"); use sphere lights where the reference must converge"));
+    for (const auto& s : desc.surfaces) diffuse = diffuse || s.material.type == MaterialDesc::Type::Diffuse;
+    if (deltaLight && diffuse && hasBendingGlass(scene))
+        warn(str(desc.file, ": the caustics that a delta light (point, spot, directional or collimated_quad) "
+                            "casts through refracting glass onto diffuse surfaces are missing from a "
+                            "unidirectional path tracer (in media the caustic photons give them), except "
+                            "through glass spheres with render.sphere_caustics; use sphere lights where the "
+                            "reference must converge"));
 }
 
 // Scene::deltaLightCaustics.

@@ -25,6 +25,18 @@
 
 namespace vdbmarch {
 class PathGuide;
+struct PhaseMixture;
+
+// Light a path cannot find, estimated by a layer above this one and added
+// once, at a path's first medium vertex: the caustics of delta lights through
+// refracting glass, from the photons (estimators/reference_tracer.cpp). Its
+// value at x is the whole in-scattered radiance of that light towards wo,
+// every later scattering included, so the path's later vertices leave it out.
+class InScatteredLight {
+public:
+    virtual ~InScatteredLight() = default;
+    virtual Color at(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const = 0;
+};
 }
 
 namespace vdbmarch {
@@ -41,6 +53,8 @@ struct PathState {
     // Free flights and medium directions by this guide where it takes them
     // (path_guide.h); null: delta tracking and phase sampling.
     const PathGuide* guide = nullptr;
+    // Added at the next medium vertex, then cleared (InScatteredLight).
+    const InScatteredLight* firstVertexLight = nullptr;
     // Guided roulette and splitting (roulette.h, weightWindow): the pixel's
     // estimate from the guide, set on the camera path's first guided segment
     // (0: roulette by throughput), and how many paths this one may still

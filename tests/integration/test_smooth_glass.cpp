@@ -26,18 +26,6 @@ const std::string& workDir() {
     return dir.path();
 }
 
-void writeIcosahedron(const std::string& path) {
-    const float t = (1 + std::sqrt(5.f)) / 2;
-    const float v[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    const int f[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                          {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                          {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-    std::ofstream out(path);
-    for (const auto& p : v) out << "v " << p[0] / 1.902f << " " << p[1] / 1.902f << " " << p[2] / 1.902f << "\n";
-    for (const auto& t3 : f) out << "f " << t3[0] + 1 << " " << t3[1] + 1 << " " << t3[2] + 1 << "\n";
-}
-
 std::string sceneText(bool smooth, bool smoke) {
     return str(R"({
   "camera": {"position": [0, 0.2, 4], "look_at": [0, 0, 0], "fov_deg": 40, "resolution": [48, 36]},
@@ -65,7 +53,7 @@ std::string sceneText(bool smooth, bool smoke) {
 
 Image render(bool smooth, bool smoke, Method method, int spp, uint64_t seed) {
     const std::string file = workDir() + (smooth ? "/smooth" : "/flat") + (smoke ? "_smoke.json" : ".json");
-    writeIcosahedron(workDir() + "/ico.obj");
+    test::writeIcosahedron(workDir() + "/ico.obj");
     std::ofstream(file) << sceneText(smooth, smoke);
     SceneDesc d = loadSceneFile(file, {str("render.spp=", spp), str("render.seed=", seed)});
     d.render.method = method;

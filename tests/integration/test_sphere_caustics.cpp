@@ -40,6 +40,13 @@ Image renderWith(const std::string& sample, const std::vector<std::string>& over
     return renderSampleToggled(sample, overrides, "render.sphere_caustics", caustics, seed);
 }
 
+// The path tracer without the connections and without the caustic photons
+// that then take their place in media: the light paths find alone.
+Image pathsAlone(const std::string& sample, std::vector<std::string> overrides, int seed = 3) {
+    overrides.push_back("photons.count=0");
+    return renderWith(sample, overrides, false, seed);
+}
+
 const std::vector<std::string> CausticScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
                                                "render.max_depth=4", "render.spp=768"};
 
@@ -118,7 +125,7 @@ TEST(SphereCausticRenders, APointLightAgreesWithASmallSphereLightOfItsIntensity)
     // And the connections carry light the paths cannot find: without
     // them the image is darker by far more than its noise.
     const Image on = renderWith("scenes/fig4_caustic.json", point, true);
-    const Image off = renderWith("scenes/fig4_caustic.json", point, false);
+    const Image off = pathsAlone("scenes/fig4_caustic.json", point);
     SampleStats diff;
     for (int y = 0; y < on.height; ++y)
         for (int x = 0; x < on.width; ++x) diff.add(average(on.rgb(x, y)) - average(off.rgb(x, y)));
@@ -152,7 +159,7 @@ TEST(SphereCausticRenders, ASpotWhoseConeHoldsTheBallAddsThePointLightsCaustic) 
                               "falloff_deg": 5, "intensity": 23}])");
     auto added = [](const std::vector<std::string>& o) {
         Image on = renderWith("scenes/fig4_caustic.json", o, true);
-        const Image off = renderWith("scenes/fig4_caustic.json", o, false);
+        const Image off = pathsAlone("scenes/fig4_caustic.json", o);
         for (size_t i = 0; i < on.rgba.size(); ++i) on.rgba[i] -= off.rgba[i];
         return on;
     };
@@ -335,7 +342,7 @@ TEST(SphereCausticRenders, ACollimatedBeamHoldingTheBallAddsTheSunsCaustic) {
                                "v": [0, 0.14, 1.4], "direction": [0.25, -1, 0.1], "irradiance": [3, 2.9, 2.7]}])");
     auto added = [](const std::vector<std::string>& o) {
         Image on = renderWith("scenes/fig4_caustic.json", o, true);
-        const Image off = renderWith("scenes/fig4_caustic.json", o, false);
+        const Image off = pathsAlone("scenes/fig4_caustic.json", o);
         for (size_t i = 0; i < on.rgba.size(); ++i) on.rgba[i] -= off.rgba[i];
         return on;
     };
@@ -368,7 +375,7 @@ TEST(SphereCausticRenders, TheSunsCausticAgreesWithThePhotonsOfTheMarcher) {
             for (int x = 0; x < img.width; ++x) m.add(average(img.rgb(x, y)));
         return m.mean();
     };
-    const double off = mean(renderWith("scenes/fig4_caustic.json", o, false));
+    const double off = mean(pathsAlone("scenes/fig4_caustic.json", o));
     const double byConnections = mean(renderWith("scenes/fig4_caustic.json", o, true)) - off;
     const double byPhotons = mean(renderWith("scenes/fig4_caustic.json", marcher, false)) - off;
     EXPECT_GT(byPhotons, 0.03 * off);  // the caustic is a visible part of the image

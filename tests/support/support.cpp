@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -525,6 +526,18 @@ LightDesc sphereLight(const Vec3& p, float radius, const Color& power) {
 std::string methodParamName(const ::testing::TestParamInfo<Method>& info) { return methodName(info.param); }
 
 std::string methodOverride(Method m) { return str("render.method=\"", methodName(m), "\""); }
+
+void writeIcosahedron(const std::string& path) {
+    const float t = (1 + std::sqrt(5.f)) / 2;
+    const float v[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    const int f[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                          {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                          {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    std::ofstream out(path);
+    for (const auto& p : v) out << "v " << p[0] / 1.902f << " " << p[1] / 1.902f << " " << p[2] / 1.902f << "\n";
+    for (const auto& t3 : f) out << "f " << t3[0] + 1 << " " << t3[1] + 1 << " " << t3[2] + 1 << "\n";
+}
 
 GlassSphere figure4Ball() {
     GlassSphere s;

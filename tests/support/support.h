@@ -152,6 +152,10 @@ bool mentionsVec3(const std::string& msg, const std::string& x, const std::strin
 // True when `msg` contains `number` as a whole token (not part of a longer number).
 bool hasNumberToken(const std::string& msg, const std::string& number);
 
+// A 20-triangle icosahedron of circumradius 1 / 1.902 (about 0.53) about
+// the origin, written to `path` as OBJ: a small glass mesh for tests.
+void writeIcosahedron(const std::string& path);
+
 // The glass ball of the paper's figure 4 (vdb_samples/scenes/fig4_caustic*.json):
 // radius 0.45 at (0, 0.75, 0), n = 1.5.
 GlassSphere figure4Ball();
