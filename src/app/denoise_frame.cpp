@@ -39,6 +39,15 @@ ExrLayer rgbLayer(const char* name, const Image& img) {
     return l;
 }
 
+void appendHalfLayers(std::vector<ExrLayer>& layers, Image&& even, Image&& odd, const Image& emittedEven,
+                      const Image& emittedOdd) {
+    layers.push_back({EvenHalfLayer, {"R", "G", "B", "A"}, std::move(even.rgba)});
+    layers.push_back({OddHalfLayer, {"R", "G", "B", "A"}, std::move(odd.rgba)});
+    if (emittedEven.empty()) return;
+    layers.push_back(rgbLayer(EmittedEvenLayer, emittedEven));
+    layers.push_back(rgbLayer(EmittedOddLayer, emittedOdd));
+}
+
 bool isDenoiserInput(const ExrLayer& l) {
     return l.name == EvenHalfLayer || l.name == OddHalfLayer || l.name == EmittedEvenLayer || l.name == EmittedOddLayer;
 }

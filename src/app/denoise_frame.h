@@ -28,6 +28,12 @@ ExrLayer rgbaLayer(const char* name, const Image& img);
 // Its RGB only.
 ExrLayer rgbLayer(const char* name, const Image& img);
 
+// Appends the denoiser's input to `layers`: the halves (EvenHalfLayer,
+// OddHalfLayer, their pixels moved in) and, where kept (not empty), their
+// emitted parts.
+void appendHalfLayers(std::vector<ExrLayer>& layers, Image&& even, Image&& odd, const Image& emittedEven,
+                      const Image& emittedOdd);
+
 // The denoised frame from the half layers (EvenHalfLayer, OddHalfLayer),
 // their emitted parts (EmittedEvenLayer, EmittedOddLayer) and the albedo,
 // normal and depth AOV layers among `layers` when present;

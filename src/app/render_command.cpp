@@ -250,12 +250,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         // leaves of it (docs/noise.md, "Timed renders").
         options.denoisedVariance = [threads = desc.render.threads](const FrameHalves& f) {
             std::vector<ExrLayer> layers = f.aovs;
-            layers.push_back(rgbaLayer(EvenHalfLayer, f.even));
-            layers.push_back(rgbaLayer(OddHalfLayer, f.odd));
-            if (!f.emittedEven.empty()) {
-                layers.push_back(rgbLayer(EmittedEvenLayer, f.emittedEven));
-                layers.push_back(rgbLayer(EmittedOddLayer, f.emittedOdd));
-            }
+            appendHalfLayers(layers, Image(f.even), Image(f.odd), f.emittedEven, f.emittedOdd);
             std::vector<float> variances;
             denoiseFrame(f.even.width, f.even.height, layers, threads, &variances);
             return variances;
@@ -333,12 +328,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         // AOV features among them). The EXR keeps them with the denoised
         // RGBA and the noisy beauty; a tile keeps its noisy RGBA and the
         // halves for merge; a preview-only EXR drops them again.
-        r.layers.push_back({EvenHalfLayer, {"R", "G", "B", "A"}, std::move(r.evenHalf.rgba)});
-        r.layers.push_back({OddHalfLayer, {"R", "G", "B", "A"}, std::move(r.oddHalf.rgba)});
-        if (!r.emittedEven.empty()) {
-            r.layers.push_back(rgbLayer(EmittedEvenLayer, r.emittedEven));
-            r.layers.push_back(rgbLayer(EmittedOddLayer, r.emittedOdd));
-        }
+        appendHalfLayers(r.layers, std::move(r.evenHalf), std::move(r.oddHalf), r.emittedEven, r.emittedOdd);
         if (!tile.any()) {
             const auto d0 = std::chrono::steady_clock::now();
             preview = denoiseFrame(r.image.width, r.image.height, r.layers, desc.render.threads);

@@ -29,9 +29,7 @@ class CausticPhotons final : public InScatteredLight {
 public:
     explicit CausticPhotons(const Illumination& il) : mIl(il) {}
     Color at(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const override {
-        if (!mIl.indirect) return Color(0);
-        return mIl.indirect->estimateLi(x, wo, size_t(mIl.k), [&](float c) { return phase.eval(c); }, nullptr,
-                                        mIl.radiusScale);
+        return mIl.photonLi(x, wo, phase);
     }
 
 private:

@@ -63,6 +63,11 @@ bool refinesCacheAt(int pass) { return pass > 0 && ((pass + 1) & pass) == 0; }  
 
 }  // namespace
 
+Color Illumination::photonLi(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const {
+    if (!indirect) return Color(0);
+    return indirect->estimateLi(x, wo, size_t(k), [&](float c) { return phase.eval(c); }, nullptr, radiusScale);
+}
+
 Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq) {
     const auto start = Clock::now();
     Illumination il;

@@ -12,6 +12,7 @@
 #include "cache/radiance_cache.h"
 #include "photons/photon_map.h"
 #include "scene/scene.h"
+#include "transport/phase.h"
 
 namespace vdbmarch {
 
@@ -61,6 +62,10 @@ struct Illumination {
     int photonPass = 0;
     float radiusScale = 1;
     IlluminationStats stats;
+
+    // Eq. 4 at x towards wo over the current pass's map `indirect`, its k
+    // nearest photons gathered within the pass's radius; 0 without a map.
+    Color photonLi(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const;
 };
 
 // The one path: traces photons when anything needs them, builds the kd-trees
