@@ -28,8 +28,8 @@ namespace {
 class CausticPhotons final : public InScatteredLight {
 public:
     explicit CausticPhotons(const Illumination& il) : mIl(il) {}
-    Color at(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const override {
-        return mIl.photonLi(x, wo, phase);
+    Color at(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const override {
+        return mIl.photonLi(x, region, wo, phase);
     }
 
 private:

@@ -183,7 +183,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     const ScatterVertex vertex = ScatterVertex::inMedium(x, rayDir, mp.phase);
     // Eq. 4 over the photons the L_i source keeps (none: no photon map),
     // gathered within this photon pass's radius.
-    auto photons = [&] { return il.photonLi(x, -rayDir, mp.phase); };
+    auto photons = [&] { return il.photonLi(x, region, -rayDir, mp.phase); };
     auto direct = [&](const Color& Ld) {
         if (tallyHere) m.liDirect = Ld;
         return Ld;

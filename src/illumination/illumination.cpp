@@ -48,7 +48,7 @@ std::unique_ptr<PhotonMap> indirectMap(const std::vector<Photon>& photons, const
     kept.reserve(count);
     for (const Photon& p : photons)
         if (wantedInMap(p, rq)) kept.push_back(p);
-    return std::make_unique<PhotonMap>(std::move(kept));
+    return std::make_unique<PhotonMap>(std::move(kept), PhotonMap::Search::ByRegion);
 }
 
 // Photon pass `pass`'s batch: pass 0 takes the photon seed itself (so a
@@ -63,9 +63,10 @@ bool refinesCacheAt(int pass) { return pass > 0 && ((pass + 1) & pass) == 0; }  
 
 }  // namespace
 
-Color Illumination::photonLi(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const {
+Color Illumination::photonLi(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const {
     if (!indirect) return Color(0);
-    return indirect->estimateLi(x, wo, size_t(k), [&](float c) { return phase.eval(c); }, nullptr, radiusScale);
+    return indirect->estimateLi(x, wo, size_t(k), [&](float c) { return phase.eval(c); }, nullptr, radiusScale,
+                                region);
 }
 
 Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq) {

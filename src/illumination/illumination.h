@@ -63,9 +63,10 @@ struct Illumination {
     float radiusScale = 1;
     IlluminationStats stats;
 
-    // Eq. 4 at x towards wo over the current pass's map `indirect`, its k
-    // nearest photons gathered within the pass's radius; 0 without a map.
-    Color photonLi(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const;
+    // Eq. 4 at x (in medium region `region`) towards wo over the current
+    // pass's map `indirect`, its k nearest photons of that region gathered
+    // within the pass's radius; 0 without a map.
+    Color photonLi(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const;
 };
 
 // The one path: traces photons when anything needs them, builds the kd-trees

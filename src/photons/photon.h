@@ -57,7 +57,7 @@ struct Photon {
     Vec3 position;
     uint32_t direction;  // encodeDirection(travel direction)
     Color weight;        // Phi / sigma_t at the collision (W m), per channel
-    uint32_t flags;      // bits 0-3: Flags; bits 16-31: the phase g there, as int16 / 32767
+    uint32_t flags;      // bits 0-3: Flags; bits 4-15: region(); bits 16-31: the phase g there, as int16 / 32767
 
     Vec3 travelDirection() const { return decodeDirection(direction); }
     bool isDirect() const { return (flags & Direct) != 0; }
@@ -67,10 +67,15 @@ struct Photon {
     // Mean cosine of the phase function where the photon landed (the
     // sigma_s-weighted mean over the media there), for eq. 27's w'_l = g^l.
     float g() const { return float(int16_t(uint16_t(flags >> 16))) / 32767.f; }
+    // The medium region (Scene::regions) it landed in, up to MaxRegion;
+    // regions beyond it share MaxRegion.
+    static constexpr int MaxRegion = 0xfff;
+    int region() const { return int((flags >> 4) & 0xfffu); }
     // bits: Flags or-ed together.
-    static uint32_t packFlags(uint32_t bits, float g) {
+    static uint32_t packFlags(uint32_t bits, float g, int region = 0) {
         int q = int(std::lround(std::min(1.f, std::max(-1.f, g)) * 32767.f));
-        return (bits & 0xffffu) | (uint32_t(uint16_t(int16_t(q))) << 16);
+        const uint32_t r = uint32_t(std::min(MaxRegion, std::max(0, region)));
+        return (bits & 0xfu) | (r << 4) | (uint32_t(uint16_t(int16_t(q))) << 16);
     }
 };
 static_assert(sizeof(Photon) == 32, "photons are stored compactly");

@@ -122,7 +122,7 @@ private:
                 ph.flags = Photon::packFlags((direct ? Photon::Direct : 0u) | (caustic ? Photon::Caustic : 0u) |
                                                  (src.pointLight ? Photon::FromPointLight : 0u) |
                                                  (lensRefractions >= 1 ? Photon::Connected : 0u),
-                                             w[1]);
+                                             w[1], region);
                 out.push_back(ph);
                 if (!(rng.uniform() * st < ss) || ++depth >= maxDepth) {
                     ended = true;

@@ -199,7 +199,7 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             const float deltaWeight = foldTrackingWeight(ctx, lightDistances, folds, t, mp);
             const bool caustics = nextEvent(vertex, weights, deltaWeight);
             if (st.firstVertexLight) {
-                add(beta * st.firstVertexLight->at(x, -ray.d, mp.phase), st.depth);
+                add(beta * st.firstVertexLight->at(x, region, -ray.d, mp.phase), st.depth);
                 st.firstVertexLight = nullptr;
             }
             // Guided roulette and splitting of what follows the vertex.

@@ -35,7 +35,7 @@ struct PhaseMixture;
 class InScatteredLight {
 public:
     virtual ~InScatteredLight() = default;
-    virtual Color at(const Vec3& x, const Vec3& wo, const PhaseMixture& phase) const = 0;
+    virtual Color at(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const = 0;
 };
 }
 

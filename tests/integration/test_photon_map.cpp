@@ -5,6 +5,7 @@
 // isotropic and a strongly forward-scattering medium.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -194,7 +195,81 @@ TEST(PhotonStorage, CompactDirectionAndPhase) {
         EXPECT_TRUE(p.isCaustic());
         EXPECT_TRUE(p.isFromPointLight());
         EXPECT_NEAR(p.g(), g, 1.f / 32767);
+        EXPECT_EQ(p.region(), 0);
+        for (int region : {1, 7, Photon::MaxRegion}) {
+            p.flags = Photon::packFlags(Photon::Caustic | Photon::Connected, g, region);
+            EXPECT_EQ(p.region(), region);
+            EXPECT_TRUE(p.isCaustic() && p.isConnected() && !p.isDirect() && !p.isFromPointLight());
+            EXPECT_NEAR(p.g(), g, 1.f / 32767);
+        }
+        p.flags = Photon::packFlags(0, g, Photon::MaxRegion + 5);  // beyond: shares the last
+        EXPECT_EQ(p.region(), Photon::MaxRegion);
     }
+}
+
+// Search::ByRegion: the k nearest of the query's region, exactly those a
+// brute-force search over that region's photons finds, whatever lies
+// nearer on the other side of a boundary.
+TEST(PhotonMapRegions, NearestAreTheNearestOfTheQuerysRegion) {
+    Rng rng(21);
+    std::vector<Photon> photons(6000);
+    for (Photon& p : photons) {
+        p.position = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 2.f - Vec3(1.f);
+        p.direction = encodeDirection(Vec3(0, 0, 1));
+        // Region 1 is the ball of radius 0.5 and is dense; region 0 the rest.
+        const int region = length(p.position) < 0.5f ? 1 : rng.uniform() < 0.5f ? 0 : 3;
+        p.weight = Color(region == 1 ? 0.005f : 1.f);
+        p.flags = Photon::packFlags(0, 0.f, region);
+    }
+    const PhotonMap all(photons), byRegion(photons, PhotonMap::Search::ByRegion);
+    constexpr size_t K = 20;
+    uint32_t idx[K];
+    float d2[K];
+    int checked = 0;
+    for (int q = 0; q < 200; ++q) {
+        // Queries near the ball's surface, on either side.
+        const Vec3 x = sampleUniformSphere(rng.uniform(), rng.uniform()) * (0.45f + 0.1f * rng.uniform());
+        for (int region : {0, 1, 2, 3}) {
+            std::vector<float> brute;
+            for (const Photon& p : photons)
+                if (p.region() == region) brute.push_back(lengthSquared(p.position - x));
+            std::sort(brute.begin(), brute.end());
+            const size_t n = byRegion.nearest(x, K, idx, d2, region);
+            ASSERT_EQ(n, std::min(K, brute.size()));
+            for (size_t i = 0; i < n; ++i) {
+                EXPECT_EQ(byRegion[idx[i]].region(), region);
+                EXPECT_FLOAT_EQ(d2[i], lengthSquared(byRegion[idx[i]].position - x));
+                EXPECT_FLOAT_EQ(d2[i], brute[i]);
+            }
+            checked += int(n);
+        }
+        // Search::All ignores the region.
+        const size_t n = all.nearest(x, K, idx, d2, 1);
+        ASSERT_EQ(n, K);
+        std::vector<float> brute;
+        for (const Photon& p : photons) brute.push_back(lengthSquared(p.position - x));
+        std::sort(brute.begin(), brute.end());
+        for (size_t i = 0; i < n; ++i) EXPECT_FLOAT_EQ(d2[i], brute[i]);
+    }
+    EXPECT_GT(checked, 200 * 3 * int(K) - 1);  // regions 0, 1 and 3 hold photons; 2 none
+}
+
+// Photons carry the region they landed in: those inside a glass ball
+// holding a medium are the interior's, the rest the world's.
+TEST(PhotonTracing, PhotonsCarryTheRegionTheyLandedIn) {
+    auto scene = buildScene(loadSceneFile(test::samplePath("scenes/exp1_sphere.json"), {}));
+    ASSERT_GT(scene->regions.size(), 1u);
+    const PhotonSet set = tracePhotons(*scene, 20000, 3);
+    std::vector<size_t> perRegion(scene->regions.size(), 0);
+    for (const Photon& p : set.photons) {
+        ASSERT_LT(size_t(p.region()), scene->regions.size());
+        ++perRegion[size_t(p.region())];
+        // The region a ray from the photon's position finds itself in.
+        EXPECT_EQ(p.region(), regionAtRayStart(*scene, Ray{p.position, Vec3(0.267f, 0.534f, 0.802f)}))
+            << "photon at " << p.position.x << " " << p.position.y << " " << p.position.z;
+    }
+    // The fog around the knot and the milk inside it.
+    EXPECT_EQ(std::count_if(perRegion.begin(), perRegion.end(), [](size_t n) { return n > 0; }), 2);
 }
 
 }  // namespace
