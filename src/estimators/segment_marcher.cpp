@@ -165,7 +165,7 @@ bool MarcherScratch::buildProductSampler(const RadianceCache& cache, const Vec3&
 }
 
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
-                                  const MediumPoint& mp, Rng& rng, float pathProbability) const {
+                                  const MediumPoint& mp, Rng& rng, float pathProbability, float photonWeight) const {
     // The direct AOV: light scattered here once, when this is the camera
     // path's first event; photons and the cache count as indirect.
     MarcherScratch& m = scratch(ctx);
@@ -183,7 +183,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     const ScatterVertex vertex = ScatterVertex::inMedium(x, rayDir, mp.phase);
     // Eq. 4 over the photons the L_i source keeps (none: no photon map),
     // gathered within this photon pass's radius.
-    auto photons = [&] { return il.photonLi(x, region, -rayDir, mp.phase); };
+    auto photons = [&] { return photonWeight > 0 ? photonWeight * il.photonLi(x, region, -rayDir, mp.phase) : Color(0); };
     auto direct = [&](const Color& Ld) {
         if (tallyHere) m.liDirect = Ld;
         return Ld;

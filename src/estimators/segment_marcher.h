@@ -108,8 +108,10 @@ protected:
     // `pathProbability`: with "path", the continuation path is traced with
     // this probability and weighted by its inverse (Russian roulette), so a
     // marcher that estimates L_i at every step bounds its paths per ray.
+    // `photonWeight` scales the photons' part (0: not gathered here; see
+    // SampledMarcher's gather stride).
     Color inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
-                      Rng& rng, float pathProbability = 1) const;
+                      Rng& rng, float pathProbability = 1, float photonWeight = 1) const;
 
     // The active intervals of [0, tEnd) (empty space skipped) into
     // ctx.intervals; false when the region holds no media. A ray into
