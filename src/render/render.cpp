@@ -13,6 +13,7 @@
 #include <tbb/task_arena.h>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "core/memory.h"
 #include "core/sobol.h"
 #include "core/threads.h"
@@ -516,6 +517,29 @@ void checkImageMemory(int width, int height, const AovSet& aovs, bool emitted) {
                 str("camera.resolution = [", width, ", ", height, "]: the image"));
 }
 
+bool keepShareOfBlocks(std::vector<int>& convergedAt, int width, int height, int blockSize, double share, int n) {
+    const int bx = (width + blockSize - 1) / blockSize, blocks = bx * ((height + blockSize - 1) / blockSize);
+    auto pixelsOf = [&](int b, auto&& f) {
+        const int x0 = (b % bx) * blockSize, y0 = (b / bx) * blockSize;
+        for (int y = y0; y < std::min(y0 + blockSize, height); ++y)
+            for (int x = x0; x < std::min(x0 + blockSize, width); ++x) f(size_t(y) * size_t(width) + size_t(x));
+    };
+    std::vector<std::pair<uint64_t, int>> order;  // the blocks still sampling, in a fixed scattered order
+    for (int b = 0; b < blocks; ++b) {
+        bool active = false;
+        pixelsOf(b, [&](size_t p) { active = active || convergedAt[p] == 0; });
+        if (active) order.push_back({mixBits(uint64_t(b) + 1), b});
+    }
+    std::sort(order.begin(), order.end());
+    const size_t keep = size_t(std::lround(std::clamp(share, 0.0, 1.0) * double(order.size())));
+    if (keep == 0) return false;
+    for (size_t i = keep; i < order.size(); ++i)
+        pixelsOf(order[i].second, [&](size_t p) {
+            if (convergedAt[p] == 0) convergedAt[p] = n;
+        });
+    return true;
+}
+
 RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     const RenderSettings& rs = scene.desc.render;
     const int w = scene.camera->width(), h = scene.camera->height();
@@ -840,7 +864,21 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             // At least two samples where the halves are kept: the denoiser
             // needs both (a one-sample render is written noisy).
             const int fewest = options.keepHalves ? 2 : 1;
-            if (first + spp >= fewest && elapsed + 1.05 * perSample + photonsBeforeSample(spp) > budget * 0.98) break;
+            if (first + spp >= fewest && elapsed + 1.05 * perSample + photonsBeforeSample(spp) > budget * 0.98) {
+                // The time left buys part of one more sample (after its photon
+                // pass, where it starts one): the pixels of a share of the
+                // still-sampling work blocks take it (spread over the frame in
+                // a fixed order), the others stop where they are. Where a sample costs seconds (guided marching at
+                // 640x480) this was up to a fifth of the budget left unused.
+                if (timedAdaptive && !options.photonPassRange) {
+                    const double share = (budget * 0.98 - elapsed - photonsBeforeSample(spp)) / (1.05 * perSample);
+                    if (share > 0.05 && keepShareOfBlocks(sums.convergedAt, ww, wh, WorkBlockSize, share, spp)) {
+                        renderSamples(spp, spp + 1);
+                        ++spp;
+                    }
+                }
+                break;
+            }
         } while (spp < (1 << 24));
         progress.set(1.0);
     }

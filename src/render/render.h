@@ -222,6 +222,13 @@ uint64_t imageMemoryBytes(int width, int height, const AovSet& aovs = {}, bool e
 // count is not in [1, height] or index not in [0, count).
 PixelRect tileOfFrame(int index, int count, int width, int height);
 
+// A timed render's last sample, when the time left buys only part of one:
+// keeps about `share` of the blockSize x blockSize blocks that still sample
+// (those with a pixel whose convergedAt is 0), taken in a fixed order spread
+// over the frame, and stops the still-sampling pixels of the others at n
+// samples (convergedAt = n). False, changing nothing, when it keeps none.
+bool keepShareOfBlocks(std::vector<int>& convergedAt, int width, int height, int blockSize, double share, int n);
+
 // Renders the scene with scene.desc.render's method, spp, seed and threads.
 // Deterministic: each pixel sample has its own random stream, so the image is
 // bit-identical for any thread count.

@@ -127,6 +127,61 @@ TEST(NoiseTarget, SppCapsIt) {
     EXPECT_GT(r.noise.relative(), 0.001);
 }
 
+// A timed render's partial last sample: whole blocks that still sample keep
+// it, about the share asked for, the rest stop where they are; blocks and
+// pixels already stopped are left alone.
+TEST(PartialLastSample, KeepsAShareOfTheStillSamplingBlocks) {
+    const int w = 100, h = 70, block = 16;  // 7 x 5 blocks, the last row and column partial
+    const int blocksX = 7, blocks = 35;
+    std::vector<int> start(size_t(w * h), 0);
+    auto blockOf = [&](int p) { return (p % w) / block + ((p / w) / block) * blocksX; };
+    // Blocks 3 and 10 stopped entirely at 6 samples; one pixel of block 20 stopped too.
+    for (int p = 0; p < w * h; ++p)
+        if (blockOf(p) == 3 || blockOf(p) == 10) start[size_t(p)] = 6;
+    const int lonePixel = 4 * block * w + 4 * block + 3;  // block 4 + 4 * 7 = 32
+    ASSERT_EQ(blockOf(lonePixel), 32);
+    start[size_t(lonePixel)] = 5;
+    for (double share : {0.0, 0.01, 0.25, 0.5, 0.99, 1.0}) {
+        std::vector<int> c = start;
+        const bool kept = keepShareOfBlocks(c, w, h, block, share, 9);
+        const int active = blocks - 2;
+        const int expectKept = int(std::lround(share * active));
+        EXPECT_EQ(kept, expectKept > 0) << share;
+        int keptBlocks = 0;
+        for (int b = 0; b < blocks; ++b) {
+            int open = 0, sampling = 0, stopped = 0;
+            for (int p = 0; p < w * h; ++p) {
+                if (blockOf(p) != b) continue;
+                if (start[size_t(p)] != 0) {
+                    EXPECT_EQ(c[size_t(p)], start[size_t(p)]);  // already stopped: untouched
+                    continue;
+                }
+                ++open;
+                sampling += c[size_t(p)] == 0;
+                stopped += c[size_t(p)] == 9;
+            }
+            if (open == 0) continue;  // blocks 3 and 10
+            // A block keeps sampling or stops as a whole.
+            EXPECT_TRUE(sampling == open || stopped == open) << "block " << b << " share " << share;
+            keptBlocks += sampling == open;
+        }
+        if (kept) {
+            EXPECT_EQ(keptBlocks, expectKept) << share;
+        } else {
+            EXPECT_EQ(c, start) << share;
+        }
+    }
+    // The same share keeps the same blocks, a larger one keeps those and more.
+    std::vector<int> a = start, b = start;
+    keepShareOfBlocks(a, w, h, block, 0.3, 9);
+    keepShareOfBlocks(b, w, h, block, 0.6, 9);
+    for (int p = 0; p < w * h; ++p) {
+        if (a[size_t(p)] == 0) {
+            EXPECT_EQ(b[size_t(p)], 0);
+        }
+    }
+}
+
 TEST(NoiseTarget, BadValuesAreRefused) {
     for (const char* v : {"0", "-0.1", "20", "\"x\""})
         expectErrorContaining<InputError>([&] { cloud({str("render.noise=", v)}); }, {"render.noise"});
