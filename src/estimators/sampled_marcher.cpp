@@ -95,16 +95,15 @@ private:
         return int(std::clamp(n, double(std::max(1, M / MinSamplesDivisor)), double(MaxSamplesFactor * M)));
     }
 
-    // How many of a segment's n L_i samples share one gather of the caustic
-    // photons: all of them, with render.li = "path" where the map holds
+    // Whether a segment gathers the photons at one of its L_i samples
+    // rather than at each: with render.li = "path" where the map holds
     // caustics alone. Not the multiply scattered light of point and spot
     // lights (pointLightsByPhotons), which varies along a ray as 1 / d^2
     // near the light: one gather per segment doubled exp1_point's MSE at
     // 16 s. Nor the paper's "photons", which gathers at every sample.
-    int gatherStride(int n) const {
+    bool gathersOncePerSegment() const {
         const Illumination& il = *mIllumination;
-        if (il.li != LiSource::Path || !il.indirect || il.pointLightsByPhotons) return 1;
-        return std::max(1, n);
+        return il.li == LiSource::Path && il.indirect && !il.pointLightsByPhotons;
     }
 
     bool marchSegment(ThreadContext& ctx, int region, const Ray& ray, float tEnd, Rng& rng, Color& L,
@@ -210,13 +209,13 @@ private:
                 const bool crossesFolds = mLightShare > 0 && prepareFoldDistances(ctx, region, ray, tEnd, folds);
                 const RayPdf::Mixture mixture{a, &lights, crossesFolds ? FoldDistanceShare : 0.0, &folds};
                 MediumPoint ms;
-                // The caustic photons (render.li = "path") at every stride-th
-                // sample from a random first one, weighted by the stride: each
-                // sample is gathered with probability 1 / stride, so the sum
-                // is unbiased. The gather is the dearest part of an L_i
-                // sample, while the paths' noise wants every sample.
-                const int stride = gatherStride(n);
-                const int firstGather = stride > 1 ? std::min(stride - 1, int(rng.uniform() * float(stride))) : 0;
+                // The caustic photons at one of the n samples, drawn uniformly
+                // and weighted by n: each sample is gathered with probability
+                // 1 / n, so the sum is unbiased. The gather is the dearest
+                // part of an L_i sample, while the paths' noise wants every
+                // sample. (-1: every sample gathers.)
+                const int gatherAt =
+                    gathersOncePerSegment() && n > 1 ? std::min(n - 1, int(rng.uniform() * float(n))) : -1;
                 for (int j = 0; j < n; ++j) {
                     int k;
                     float offset, t;
@@ -225,7 +224,7 @@ private:
                         continue;
                     const Vec3 x = ray.at(t);
                     evalMedia(ctx, region, x, ms);  // the phase mixture at x
-                    const float photonWeight = j % stride == firstGather ? float(stride) : 0.f;
+                    const float photonWeight = gatherAt < 0 ? 1.f : j == gatherAt ? float(n) : 0.f;
                     const Color Li = inScattered(ctx, region, x, ray.d, ms, rng, 1.f, photonWeight);
                     if (isBlack(Li)) continue;
                     Color Tt = m.stepT[size_t(k)];

@@ -109,7 +109,7 @@ protected:
     // this probability and weighted by its inverse (Russian roulette), so a
     // marcher that estimates L_i at every step bounds its paths per ray.
     // `photonWeight` scales the photons' part (0: not gathered here; see
-    // SampledMarcher's gather stride).
+    // SampledMarcher::gathersOncePerSegment).
     Color inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
                       Rng& rng, float pathProbability = 1, float photonWeight = 1) const;
 

@@ -13,8 +13,8 @@
 #include <tbb/task_arena.h>
 
 #include "core/error.h"
-#include "core/rng.h"
 #include "core/memory.h"
+#include "core/rng.h"
 #include "core/sobol.h"
 #include "core/threads.h"
 #include "estimators/estimator.h"
@@ -864,14 +864,16 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             // At least two samples where the halves are kept: the denoiser
             // needs both (a one-sample render is written noisy).
             const int fewest = options.keepHalves ? 2 : 1;
-            if (first + spp >= fewest && elapsed + 1.05 * perSample + photonsBeforeSample(spp) > budget * 0.98) {
+            const double photonsNext = photonsBeforeSample(spp);
+            if (first + spp >= fewest && elapsed + 1.05 * perSample + photonsNext > budget * 0.98) {
                 // The time left buys part of one more sample (after its photon
                 // pass, where it starts one): the pixels of a share of the
                 // still-sampling work blocks take it (spread over the frame in
-                // a fixed order), the others stop where they are. Where a sample costs seconds (guided marching at
-                // 640x480) this was up to a fifth of the budget left unused.
+                // a fixed order), the others stop where they are. Where a
+                // sample costs seconds (guided marching at 640x480) up to half
+                // of a 12 s budget was left unused (docs/noise.md).
                 if (timedAdaptive && !options.photonPassRange) {
-                    const double share = (budget * 0.98 - elapsed - photonsBeforeSample(spp)) / (1.05 * perSample);
+                    const double share = (budget * 0.98 - elapsed - photonsNext) / (1.05 * perSample);
                     if (share > 0.05 && keepShareOfBlocks(sums.convergedAt, ww, wh, WorkBlockSize, share, spp)) {
                         renderSamples(spp, spp + 1);
                         ++spp;
