@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "transport/beam_directions.h"
 #include "transport/direct_light.h"
 #include "transport/glass_splitting.h"
 #include "transport/path_tracer.h"
@@ -209,6 +210,10 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     const ProductDirectionSampler* product = nullptr;
     if (mProductSampling && m.buildProductSampler(*mIllumination->cache, x, rayDir, mp, nextEventVertex))
         product = &m.productSampler;
+    // Else, as at the path tracer's vertices, a share of the directions
+    // towards spot and collimated beams (transport/beam_directions.h).
+    BeamMixture beams{&ctx, region, &nextEventVertex};
+    const bool beamDirections = !product && beams.attach(nextEventVertex, il.pointLightsByPhotons);
     Color Li = direct(directLight(ctx, region, nextEventVertex, rng, kNextEvent));
     // Sphere lights through glass spheres too, weighed against the
     // continuation's own hits, and point and spot lights, whose photons
@@ -231,10 +236,13 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
             wi = s.wi;
             weight *= s.weight;
             pdf = s.pdf;
+        } else if (beamDirections) {
+            wi = beams.sample(rng, weight, pdf);
         } else {
             wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
         }
         PathState state;
+        if (beamDirections) scaleRoulette(state, nextEventVertex, wi, pdf);
         state.depth = depth;
         state.specular = false;
         state.lastPdf = pdf;

@@ -61,17 +61,87 @@ const std::vector<float>* phaseAngleIntegral(float g) {
     return table.get();
 }
 
+// The axial range [s0, s1] of `hull` along a beam from `origin` (its
+// corners' projections).
+void axialRange(const BBox& hull, const Vec3& origin, const Vec3& axis, float& s0, float& s1) {
+    s0 = Infinity;
+    s1 = -Infinity;
+    for (int c = 0; c < 8; ++c) {
+        const Vec3 p(c & 1 ? hull.hi.x : hull.lo.x, c & 2 ? hull.hi.y : hull.lo.y, c & 4 ? hull.hi.z : hull.lo.z);
+        const float s = dot(p - origin, axis);
+        s0 = std::min(s0, s);
+        s1 = std::max(s1, s);
+    }
+}
+
+// A spot's cone, where its distance sampling may pay in the region
+// (light_distance.h's candidates).
+bool spotBeam(ThreadContext& ctx, const BBox& hull, size_t i, int region, ThreadContext::Beam& b) {
+    const Scene& scene = ctx.scene;
+    const Light& light = scene.lights[i];
+    if (light.desc().type != LightDesc::Type::Spot || !regionHasLightDistances(ctx, region, false) ||
+        !ctx.lightDistanceCandidate[size_t(region) * scene.lights.size() + i])
+        return false;
+    b.light = int(i);
+    b.apex = light.desc().position;
+    b.axis = normalize(light.desc().direction);
+    const double cone = double(light.desc().coneDeg) * (PiD / 180);
+    if (!(cone > 0 && cone < 0.5 * PiD * 0.99)) return false;
+    b.tanCone = float(std::tan(cone));
+    const float cosCone = float(std::cos(cone));
+    float s0, s1;
+    axialRange(hull, b.apex, b.axis, s0, s1);
+    b.s0 = std::max(s0, 1e-4f * std::max(scene.sceneScale, 1e-6f));
+    b.s1 = s1;
+    // The power it scatters per unit length (the choice between beams
+    // weighs it by the vertex's view, BeamView).
+    b.power = std::max(average(light.desc().intensity), 0.f) * (1 - cosCone);
+    return b.s1 > b.s0 && b.power > 0;
+}
+
+// A collimated quad's prism: the points the quad's parallel light reaches,
+// from the axial position where the whole cross-section is downstream of
+// the (possibly tilted) quad, over the region's hull. Its cross-section
+// perpendicular to the axis is the quad seen along the beam, of constant
+// area, so the power per unit length is the irradiance times that area.
+bool prismBeam(const Scene& scene, const BBox& hull, size_t i, int region, ThreadContext::Beam& b) {
+    const LightDesc& d = scene.lights[i].desc();
+    if (d.type != LightDesc::Type::CollimatedQuad || !openToRegion(scene, d.center, region)) return false;
+    b.light = int(i);
+    b.prism = true;
+    b.apex = d.center;
+    b.axis = normalize(d.direction);
+    b.u = d.u;
+    b.v = d.v;
+    b.uAxial = dot(d.u, b.axis);
+    b.vAxial = dot(d.v, b.axis);
+    const Vec3 n = cross(d.u, d.v);
+    const float n2 = lengthSquared(n), dn = dot(b.axis, n);
+    b.area = std::fabs(dn);
+    if (!(n2 > 0) || !(b.area > 1e-6f * n2)) return false;  // a beam along the quad's plane
+    // A point's quad coordinates along the beam: its projection along the
+    // axis onto the quad's plane, in the dual basis of u and v.
+    const Vec3 dualU = cross(d.v, n) / n2, dualV = cross(n, d.u) / n2;
+    b.dualA = dualU - n * (dot(b.axis, dualU) / dn);
+    b.dualB = dualV - n * (dot(b.axis, dualV) / dn);
+    float s0, s1;
+    axialRange(hull, b.apex, b.axis, s0, s1);
+    b.s0 = std::max(s0, 0.5f * (std::fabs(b.uAxial) + std::fabs(b.vAxial)));
+    b.s1 = s1;
+    b.power = std::max(average(d.irradiance), 0.f) * b.area;
+    coordinateSystem(b.axis, b.e1, b.e2);
+    return b.s1 > b.s0 && b.power > 0;
+}
+
 // The beams of every region, made on a thread's first use: per region a
-// list of spots with their axial range over the region's scattering media.
+// list of spots and collimated quads with their axial range over the
+// region's scattering media.
 void buildBeams(ThreadContext& ctx) {
     const Scene& scene = ctx.scene;
     const size_t nLights = scene.lights.size();
     ctx.beamRegions.assign(scene.regions.size(), {});
     for (size_t r = 0; r < scene.regions.size(); ++r) {
-        // The distance-sampling candidates say which spots can reach the
-        // region at all (no blocking surface between) and give its hull.
-        if (!regionHasLightDistances(ctx, int(r), false)) continue;
-        const BBox& hull = ctx.scatterBounds[r];
+        const BBox& hull = scatterBounds(ctx, int(r));
         if (!hull.isFinite() || hull.empty()) continue;
         // Thin media only: in a dense one a path sent towards a beam meets
         // a collision long before it, and the directions it did not take
@@ -85,33 +155,13 @@ void buildBeams(ThreadContext& ctx) {
         if (!(depth * double(length(hull.extent())) <= MaxBeamRegionDepth)) continue;
         ThreadContext::BeamRegion& out = ctx.beamRegions[r];
         for (size_t i = 0; i < nLights; ++i) {
-            const Light& light = scene.lights[i];
-            if (light.desc().type != LightDesc::Type::Spot || !ctx.lightDistanceCandidate[r * nLights + i]) continue;
             ThreadContext::Beam b;
-            b.light = int(i);
-            b.apex = light.desc().position;
-            b.axis = normalize(light.desc().direction);
-            const double cone = double(light.desc().coneDeg) * (PiD / 180);
-            if (!(cone > 0 && cone < 0.5 * PiD * 0.99)) continue;
-            b.tanCone = float(std::tan(cone));
-            const float cosCone = float(std::cos(cone));
-            // The axial range of the hull: its corners' projections.
-            float s0 = Infinity, s1 = -Infinity;
-            for (int c = 0; c < 8; ++c) {
-                const Vec3 p(c & 1 ? hull.hi.x : hull.lo.x, c & 2 ? hull.hi.y : hull.lo.y, c & 4 ? hull.hi.z : hull.lo.z);
-                const float s = dot(p - b.apex, b.axis);
-                s0 = std::min(s0, s);
-                s1 = std::max(s1, s);
+            if (spotBeam(ctx, hull, i, int(r), b)) {
+                coordinateSystem(b.axis, b.e1, b.e2);
+                out.beams.push_back(b);
+            } else if (prismBeam(scene, hull, i, int(r), b)) {
+                out.beams.push_back(b);
             }
-            b.s0 = std::max(s0, 1e-4f * std::max(scene.sceneScale, 1e-6f));
-            b.s1 = s1;
-            if (!(b.s1 > b.s0)) continue;
-            // The power it scatters per unit length (the choice between
-            // beams weighs it by the vertex's view, BeamView).
-            b.power = std::max(average(light.desc().intensity), 0.f) * (1 - cosCone);
-            if (!(b.power > 0)) continue;
-            coordinateSystem(b.axis, b.e1, b.e2);
-            out.beams.push_back(b);
         }
         if (!out.beams.empty()) out.angleIntegral = phaseAngleIntegral(regionPhaseG(scene, int(r)));
     }
@@ -176,9 +226,10 @@ struct BeamView {
     BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, const Vec3& x) : beam(&b), G(&table) {
         const Vec3 v = x - b.apex;
         sight.sx = double(dot(v, b.axis));
-        // Off the axis by at least the disc's radius at the range's start:
-        // bounded weights for a vertex on the axis.
-        sight.h = std::max(double(length(v - b.axis * float(sight.sx))), double(b.tanCone) * double(b.s0));
+        // Off the axis by at least the disc's radius at the range's start
+        // (a prism's half width): bounded weights for a vertex on the axis.
+        const double radius = b.prism ? 0.5 * std::sqrt(double(b.area)) : double(b.tanCone) * double(b.s0);
+        sight.h = std::max(double(length(v - b.axis * float(sight.sx))), radius);
         sight.g0 = angleIntegralAt(0);
         sight.g1 = angleIntegralAt(BeamBins);
         sight.weight = sight.g1 > sight.g0 ? double(b.power) * (sight.g1 - sight.g0) / sight.h : 0;
@@ -230,10 +281,30 @@ BeamView viewOf(const BeamMixture& m, size_t k) {
 // angle): per bin, its mass times the volume density 1 / (bin length x pi
 // tan^2 s^2) integrated along the ray over the cone's part in the bin, with
 // the Jacobian t^2.
+// A prism's chord: the part of x + t wi whose quad coordinates lie in
+// [-1/2, 1/2] (two slabs).
+bool prismChord(const ThreadContext::Beam& b, const Vec3& x, const Vec3& wi, float& t0, float& t1) {
+    double lo = 0, hi = double(Infinity);
+    for (const Vec3* dual : {&b.dualA, &b.dualB}) {
+        const double a = double(dot(x - b.apex, *dual)), da = double(dot(wi, *dual));
+        if (std::fabs(da) < 1e-12) {
+            if (std::fabs(a) > 0.5) return false;
+            continue;
+        }
+        double e0 = (-0.5 - a) / da, e1 = (0.5 - a) / da;
+        if (e0 > e1) std::swap(e0, e1);
+        lo = std::max(lo, e0);
+        hi = std::min(hi, e1);
+    }
+    t0 = float(lo);
+    t1 = float(hi);
+    return hi > lo;
+}
+
 double beamPdf(ThreadContext& ctx, const BeamView& view, const Vec3& x, const Vec3& wi) {
     const ThreadContext::Beam& b = *view.beam;
     float t0, t1;
-    if (!lightReach(ctx, b.light, Ray{x, wi}, t0, t1)) return 0;
+    if (b.prism ? !prismChord(b, x, wi, t0, t1) : !lightReach(ctx, b.light, Ray{x, wi}, t0, t1)) return 0;
     const double sx = double(dot(x - b.apex, b.axis)), c = double(dot(wi, b.axis));
     double ta = t0, tb = t1;
     if (std::fabs(c) < 1e-12) {
@@ -251,7 +322,10 @@ double beamPdf(ThreadContext& ctx, const BeamView& view, const Vec3& x, const Ve
     const double len = double(b.s1 - b.s0);
     const int i0 = std::clamp(int((std::min(sa, sb) - b.s0) / len * BeamBins), 0, BeamBins - 1);
     const int i1 = std::clamp(int((std::max(sa, sb) - b.s0) / len * BeamBins), 0, BeamBins - 1);
-    const double mass = view.sight.g1 - view.sight.g0, area = PiD * double(b.tanCone) * double(b.tanCone);
+    // A cone's disc has area pi tan^2 s^2 (the s^2 in inverseSquareMoment);
+    // a prism's cross-section a constant area (the plain moment of t^2).
+    const double mass = view.sight.g1 - view.sight.g0,
+                 area = b.prism ? double(b.area) : PiD * double(b.tanCone) * double(b.tanCone);
     double pdf = 0, gLo = view.angleIntegralAt(i0);
     for (int i = i0; i <= i1; ++i) {
         const double lo = view.edge(i), hi = view.edge(i + 1), gHi = view.angleIntegralAt(i + 1);
@@ -266,7 +340,8 @@ double beamPdf(ThreadContext& ctx, const BeamView& view, const Vec3& x, const Ve
             v = std::min(v, a1);
         }
         if (!(v > u)) continue;
-        pdf += binMass * inverseSquareMoment(sx, c, u, v) / ((hi - lo) * area);
+        const double moment = b.prism ? (v * v * v - u * u * u) / 3 : inverseSquareMoment(sx, c, u, v);
+        pdf += binMass * moment / ((hi - lo) * area);
     }
     return pdf;
 }
@@ -347,8 +422,17 @@ Vec3 BeamMixture::sample(Rng& rng, Color& weight, float& pdfOut) const {
         }
         const double along = gHi > gLo ? std::clamp((target - gLo) / (gHi - gLo), 0.0, 1.0) : 0.5;
         const float s = float(view.edge(lo) + along * (view.edge(lo + 1) - view.edge(lo)));
-        const float rad = s * b.tanCone * std::sqrt(u2), phi = 2 * Pi * rng.uniform();
-        const Vec3 to = b.apex + b.axis * s + (b.e1 * std::cos(phi) + b.e2 * std::sin(phi)) * rad - v.p;
+        Vec3 point;
+        if (b.prism) {
+            // Uniform over the cross-section at s: quad coordinates (a, c),
+            // moved along the beam to axial position s.
+            const float a = u2 - 0.5f, c = rng.uniform() - 0.5f;
+            point = b.apex + b.u * a + b.v * c + b.axis * (s - a * b.uAxial - c * b.vAxial);
+        } else {
+            const float rad = s * b.tanCone * std::sqrt(u2), phi = 2 * Pi * rng.uniform();
+            point = b.apex + b.axis * s + (b.e1 * std::cos(phi) + b.e2 * std::sin(phi)) * rad;
+        }
+        const Vec3 to = point - v.p;
         const float len = length(to);
         if (!(len > 0)) {
             pdfOut = 0;

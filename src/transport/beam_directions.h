@@ -1,19 +1,22 @@
-// Directions towards the beams of spot lights, mixed with f's own sampling
-// at the path tracer's medium and diffuse vertices (render.beam_directions).
+// Directions towards the beams of spot lights and collimated quads, mixed
+// with f's own sampling at the path tracer's medium and diffuse vertices and
+// at the marchers' L_i samples (render.beam_directions).
 //
-// In a thin haze lit by spots, most of the light a path can still find is
+// In a thin haze lit by beams, most of the light a path can still find is
 // in the beams (and on the floor patches they light); a phase- or
 // cosine-sampled direction crosses one rarely, and the
 // distance samples towards the light (light_distance.h) only pay on the
 // segments that do. So with probability BeamShare a vertex draws a point
-// in a beam instead and goes towards it: along the spot's axis over the
+// in a beam instead and goes towards it: along the beam's axis over the
 // axial range of the region's scattering media, in proportion to what each
 // part of the axis scatters towards the vertex (the beam's power per unit
-// length, about constant since the falloff 1/s^2 and the disc's area s^2
-// cancel, times the phase towards the vertex over the squared distance;
-// piecewise constant on bins), and uniform over the cone's disc there. The
-// density of that direction is the volume density integrated along the ray
-// (times t^2), in closed form per bin (beamDirectionPdf). The vertex weighs by the
+// length, about constant: for a spot the falloff 1/s^2 and the disc's area
+// s^2 cancel, a collimated beam has neither; times the phase towards the
+// vertex over the squared distance; piecewise constant on bins), and
+// uniform over the cross-section there (a spot's disc, the quad seen along
+// a collimated beam). The density of that direction is the volume density
+// integrated along the ray (times t^2), in closed form per bin
+// (beamDirectionPdf). The vertex weighs by the
 // one-sample mixture, f / ((1 - p) p_phase + p p_beams), so the estimate
 // is unbiased for any beams and lights, and next-event estimation meets the
 // same density by MIS (ScatterVertex::pathPdf).
@@ -31,8 +34,9 @@ constexpr float BeamShare = 0.3f;
 
 // True when the beams of region `region` are sampled at its vertices:
 // render.beam_directions, a spot light whose distance sampling may pay
-// there (light_distance.h), and bounded, thin scattering media (an optical
-// depth of at most 4 across their bounds at the densest extinction).
+// there (light_distance.h) or a collimated quad that no blocking surface
+// separates from it, and bounded, thin scattering media (an optical depth
+// of at most 4 across their bounds at the densest extinction).
 bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLights);
 
 // The density (solid angle) of a direction drawn towards the region's

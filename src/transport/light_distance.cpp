@@ -55,31 +55,23 @@ float equiangularWeight(const LightDistanceSegment& seg, float pdfEquiangular, f
     return distanceWeight(pdfEquiangular, pdfTracking);
 }
 
-// Per region the hull of its scattering media's bounds, and per (region,
-// light) whether distance sampling can ever pay there: the light is
+// Per (region, light) whether distance sampling can ever pay there: the light is
 // point-like or a sphere; no surface that blocks shadow rays separates it
 // from the region; and, for point and sphere lights (whose reach is the
 // whole ray), the falloff range over the region's bounds, at most
 // (farthest corner / nearest point)^2, can exceed the gain threshold.
 void buildCandidates(ThreadContext& ctx) {
     const Scene& scene = ctx.scene;
-    bool blocking = false;
-    for (const SurfaceInfo& surface : scene.surfaces) blocking |= !crossedByShadowRays(surface.material);
     const size_t nLights = scene.lights.size();
-    ctx.scatterBounds.assign(scene.regions.size(), BBox{});
     ctx.lightDistanceCandidate.assign(scene.regions.size() * nLights, 0);
     for (size_t r = 0; r < scene.regions.size(); ++r) {
-        BBox& hull = ctx.scatterBounds[r];
-        for (int mi : scene.regions[r].media) {
-            const Medium& m = *scene.media[size_t(mi)];
-            if (!isBlack(m.sigma_s) && !m.isVacuum()) hull.expand(m.worldBounds());
-        }
+        const BBox& hull = scatterBounds(ctx, int(r));
         if (hull.empty()) continue;
         for (size_t i = 0; i < nLights; ++i) {
             const Light& light = scene.lights[i];
             if (!(light.isPointLike() || light.isSphere())) continue;
             const Vec3& c = light.desc().position;
-            if (blocking && regionAtRayStart(scene, Ray{c, Vec3(0, 0, 1)}) != int(r)) continue;
+            if (!openToRegion(scene, c, int(r))) continue;
             bool mayPay = true;
             if (light.desc().type != LightDesc::Type::Spot && hull.isFinite()) {
                 const Vec3 nearest = min(max(c, hull.lo), hull.hi);
@@ -93,6 +85,26 @@ void buildCandidates(ThreadContext& ctx) {
 }
 
 }  // namespace
+
+const BBox& scatterBounds(ThreadContext& ctx, int region) {
+    const Scene& scene = ctx.scene;
+    if (ctx.scatterBounds.empty()) {
+        ctx.scatterBounds.assign(scene.regions.size(), BBox{});
+        for (size_t r = 0; r < scene.regions.size(); ++r)
+            for (int mi : scene.regions[r].media) {
+                const Medium& m = *scene.media[size_t(mi)];
+                if (!isBlack(m.sigma_s) && !m.isVacuum()) ctx.scatterBounds[r].expand(m.worldBounds());
+            }
+    }
+    return ctx.scatterBounds[size_t(region)];
+}
+
+bool openToRegion(const Scene& scene, const Vec3& position, int region) {
+    for (const SurfaceInfo& surface : scene.surfaces)
+        if (!crossedByShadowRays(surface.material))
+            return regionAtRayStart(scene, Ray{position, Vec3(0, 0, 1)}) == region;
+    return true;
+}
 
 bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights) {
     const Scene& scene = ctx.scene;

@@ -51,6 +51,14 @@ struct LightDistanceSegment {
 LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int channel,
                                            bool skipPointLights);
 
+// The hull of the bounds of `region`'s scattering media (made on first use).
+const BBox& scatterBounds(ThreadContext& ctx, int region);
+
+// Whether a light at `position` sees `region` with no surface that blocks
+// shadow rays between: in a scene with such surfaces, the light must lie in
+// the region (a conservative test; one without them sees every region).
+bool openToRegion(const Scene& scene, const Vec3& position, int region);
+
 // Whether some light may get distance samples on segments in `region`
 // (prepareLightDistances then needs the segment's true end).
 bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights);

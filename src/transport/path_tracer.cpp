@@ -62,14 +62,6 @@ bool roulette(Color& beta, const PathState& st, Rng& rng) {
     return st.depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold, st.rouletteScale);
 }
 
-// A direction wi of density pdf drawn by a sampler other than f's own (a
-// beam mixture, the guide's product sampler): what f's own sampling would
-// have left the throughput (PathState::rouletteScale).
-void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf) {
-    const float pf = v.fPdf(wi);
-    if (pf > 0 && pdf > 0) st.rouletteScale = std::min(st.rouletteScale * (pdf / pf), 1e20f);
-}
-
 // The state after a reflection or refraction at surface `surface`.
 void followSurfaceEvent(const Scene& scene, const SurfaceEvent& e, int surface, PathState& st) {
     if (e.straight) return;
@@ -87,6 +79,11 @@ bool hasChromaticExtinction(const Scene& scene) {
         if (k.x != k.y || k.y != k.z) return true;
     }
     return false;
+}
+
+void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf) {
+    const float pf = v.fPdf(wi);
+    if (pf > 0 && pdf > 0) st.rouletteScale = std::min(st.rouletteScale * (pdf / pf), 1e20f);
 }
 
 PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState st) {
@@ -192,7 +189,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             }
             ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
             const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
-            // Or a share of the directions towards spot beams (beam_directions.h).
+            // Or a share of the directions towards spot and collimated beams
+            // (beam_directions.h).
             BeamMixture beams{&ctx, region, &vertex};
             const bool beamDirections = !guidedDirection && beams.attach(vertex, st.pointLightsByPhotons);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
@@ -346,7 +344,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
             if (++st.depth > maxDepth) return result(0.f);
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
             ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
-            // A share of the directions towards spot beams (beam_directions.h).
+            // A share of the directions towards spot and collimated beams
+            // (beam_directions.h).
             BeamMixture beams{&ctx, region, &vertex};
             const bool beamDirections = beams.attach(vertex, st.pointLightsByPhotons);
             const bool caustics = nextEvent(vertex, nullptr, 1.f);

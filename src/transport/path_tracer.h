@@ -20,6 +20,7 @@
 #pragma once
 
 #include "core/rng.h"
+#include "transport/direct_light.h"
 #include "transport/roulette.h"
 #include "transport/thread_context.h"
 
@@ -106,6 +107,12 @@ struct PathRadiance {
 
 // The radiance the path ray (in `region`) brings back, from `state`.
 PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state);
+
+// A direction wi of density pdf drawn at vertex v by a sampler other than
+// f's own (a beam mixture, the guide's product sampler): scales the
+// state's roulette to what f's own sampling would have left the throughput
+// (PathState::rouletteScale).
+void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf);
 
 // True when some medium's extinction differs between channels.
 bool hasChromaticExtinction(const Scene& scene);

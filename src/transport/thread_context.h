@@ -54,14 +54,22 @@ struct ThreadContext {
     };
     static constexpr int ReachMemoLights = 4;  // the first lights only
     ReachMemo reachMemo[ReachMemoLights];
-    // Made on first use by beam_directions.cpp: per region, the spot beams
-    // its medium vertices draw directions towards.
+    // Made on first use by beam_directions.cpp: per region, the beams of
+    // spot lights (cones) and collimated quads (prisms) its medium vertices
+    // draw directions towards.
     struct Beam {
         int light;
-        Vec3 apex, axis, e1, e2;
-        float tanCone;
+        Vec3 apex, axis, e1, e2;  // a prism's "apex" is its quad's centre
+        float tanCone = 0;
         float s0, s1;     // the axial range sampled (the region's media)
         float power = 1;  // scattered power per unit length of beam
+        // A collimated quad's prism: the quad's edges u, v and their axial
+        // parts, the dual vectors that give a point's quad coordinates
+        // (|a|, |b| <= 1/2 inside) along the beam, and the cross-section's
+        // area perpendicular to the axis.
+        bool prism = false;
+        Vec3 u, v, dualA, dualB;
+        float uAxial = 0, vAxial = 0, area = 0;
     };
     struct BeamRegion {
         std::vector<Beam> beams;

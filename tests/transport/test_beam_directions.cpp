@@ -1,4 +1,4 @@
-// Directions towards spot beams (transport/beam_directions.h): the mixture
+// Directions towards spot and collimated beams (transport/beam_directions.h): the mixture
 // of f's own sampling and the beams draws directions with the density it
 // reports (chi-square on a fine grid of the sphere, the expected counts from
 // pdf() by Gauss-Legendre quadrature per cell), at medium vertices inside
@@ -21,15 +21,18 @@
 namespace vdbmarch {
 namespace {
 
-// Two spots of different power and cone into a haze box of g = 0.5; wide
-// cones so the beams cover many cells of the test's grid.
+// Two spots of different power and cone and a collimated quad, tilted
+// against its beam, into a haze box of g = 0.5; wide beams so they cover
+// many cells of the test's grid.
 const char* const kBeamScene = R"({
   "camera": {"position": [0, 0, 6], "look_at": [0, 0, 0], "resolution": [8, 8]},
   "lights": [
     {"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "intensity": [20, 20, 20],
      "cone_deg": 20, "falloff_deg": 5},
     {"type": "spot", "position": [-3, 0.5, 0.5], "direction": [1, -0.2, 0], "intensity": [10, 12, 14],
-     "cone_deg": 12, "falloff_deg": 3}],
+     "cone_deg": 12, "falloff_deg": 3},
+    {"type": "collimated_quad", "center": [-0.8, 1.5, -0.5], "u": [0.8, 0, 0.1], "v": [0, 0.3, 0.6],
+     "direction": [0.2, -1, -0.1], "irradiance": [3, 3, 3]}],
   "media": [{"name": "haze", "type": "homogeneous", "sigma_a": 0.02, "sigma_s": 0.3, "g": 0.5,
              "bounds": {"min": [-1.5, -1, -1], "max": [1.5, 1, 1]}}],
   "render": {"method": "reference", "beam_directions": true}
@@ -55,7 +58,8 @@ TEST_P(BeamDirections, SamplerMatchesItsPdf) {
     evalMedia(ctx, region, c.x, mp);
     ASSERT_TRUE(mp.scatters());
     ASSERT_TRUE(regionHasBeamDirections(ctx, region, false));
-    ASSERT_EQ(ctx.beamRegions[size_t(region)].beams.size(), 2u);
+    ASSERT_EQ(ctx.beamRegions[size_t(region)].beams.size(), 3u);
+    ASSERT_TRUE(ctx.beamRegions[size_t(region)].beams[2].prism);
     const ScatterVertex v = c.surface ? ScatterVertex::onSurface(c.x, c.d, Vec3(0, 1, 0), Color(0.5f))
                                       : ScatterVertex::inMedium(c.x, c.d, mp.phase);
     const BeamMixture mix{&ctx, region, &v};
@@ -127,6 +131,8 @@ INSTANTIATE_TEST_SUITE_P(Vertices, BeamDirections,
                                                     normalize(Vec3(0.3f, -1, 0.2f)), false},
                                            BeamCase{"inside a beam", Vec3(0.2f, 0.3f, -0.1f),
                                                     normalize(Vec3(1, 0.2f, -0.5f)), false},
+                                           BeamCase{"inside the prism", Vec3(-0.5f, 0.f, -0.65f),
+                                                    normalize(Vec3(0.2f, -1, -0.1f)), false},
                                            BeamCase{"on a floor", Vec3(0.7f, -0.99f, 0.4f),
                                                     normalize(Vec3(0.2f, -1, 0.1f)), true}),
                          [](const ::testing::TestParamInfo<BeamCase>& i) {
