@@ -70,11 +70,12 @@ struct Photon {
     // The medium region (Scene::regions) it landed in, up to MaxRegion;
     // regions beyond it share MaxRegion.
     static constexpr int MaxRegion = 0xfff;
+    static int storedRegion(int region) { return std::min(MaxRegion, std::max(0, region)); }
     int region() const { return int((flags >> 4) & 0xfffu); }
     // bits: Flags or-ed together.
     static uint32_t packFlags(uint32_t bits, float g, int region = 0) {
         int q = int(std::lround(std::min(1.f, std::max(-1.f, g)) * 32767.f));
-        const uint32_t r = uint32_t(std::min(MaxRegion, std::max(0, region)));
+        const uint32_t r = uint32_t(storedRegion(region));
         return (bits & 0xfu) | (r << 4) | (uint32_t(uint16_t(int16_t(q))) << 16);
     }
 };

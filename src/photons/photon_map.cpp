@@ -87,7 +87,7 @@ PhotonMap::~PhotonMap() = default;
 
 size_t PhotonMap::nearest(const Vec3& x, size_t k, uint32_t* indices, float* dist2, int region) const {
     if (mPhotons.empty() || k == 0) return 0;
-    const size_t t = mSearch == Search::ByRegion ? size_t(std::min(Photon::MaxRegion, std::max(0, region))) : 0;
+    const size_t t = mSearch == Search::ByRegion ? size_t(Photon::storedRegion(region)) : 0;
     if (t >= mTrees.size() || !mTrees[t]) return 0;
     const Tree& tree = *mTrees[t];
     const float q[3] = {x.x, x.y, x.z};

@@ -96,6 +96,7 @@ bool spotBeam(ThreadContext& ctx, const BBox& hull, size_t i, int region, Thread
     // The power it scatters per unit length (the choice between beams
     // weighs it by the vertex's view, BeamView).
     b.power = std::max(average(light.desc().intensity), 0.f) * (1 - cosCone);
+    coordinateSystem(b.axis, b.e1, b.e2);  // the disc's axes
     return b.s1 > b.s0 && b.power > 0;
 }
 
@@ -129,7 +130,6 @@ bool prismBeam(const Scene& scene, const BBox& hull, size_t i, int region, Threa
     b.s0 = std::max(s0, 0.5f * (std::fabs(b.uAxial) + std::fabs(b.vAxial)));
     b.s1 = s1;
     b.power = std::max(average(d.irradiance), 0.f) * b.area;
-    coordinateSystem(b.axis, b.e1, b.e2);
     return b.s1 > b.s0 && b.power > 0;
 }
 
@@ -155,13 +155,8 @@ void buildBeams(ThreadContext& ctx) {
         if (!(depth * double(length(hull.extent())) <= MaxBeamRegionDepth)) continue;
         ThreadContext::BeamRegion& out = ctx.beamRegions[r];
         for (size_t i = 0; i < nLights; ++i) {
-            ThreadContext::Beam b;
-            if (spotBeam(ctx, hull, i, int(r), b)) {
-                coordinateSystem(b.axis, b.e1, b.e2);
-                out.beams.push_back(b);
-            } else if (prismBeam(scene, hull, i, int(r), b)) {
-                out.beams.push_back(b);
-            }
+            ThreadContext::Beam b;  // each maker first checks the light's type
+            if (spotBeam(ctx, hull, i, int(r), b) || prismBeam(scene, hull, i, int(r), b)) out.beams.push_back(b);
         }
         if (!out.beams.empty()) out.angleIntegral = phaseAngleIntegral(regionPhaseG(scene, int(r)));
     }
@@ -277,10 +272,6 @@ BeamView viewOf(const BeamMixture& m, size_t k) {
     return BeamView(r.beams[k], *r.angleIntegral, m.vertex->p);
 }
 
-// The density of directions towards the beam of `view` from x (solid
-// angle): per bin, its mass times the volume density 1 / (bin length x pi
-// tan^2 s^2) integrated along the ray over the cone's part in the bin, with
-// the Jacobian t^2.
 // A prism's chord: the part of x + t wi whose quad coordinates lie in
 // [-1/2, 1/2] (two slabs).
 bool prismChord(const ThreadContext::Beam& b, const Vec3& x, const Vec3& wi, float& t0, float& t1) {
@@ -301,6 +292,11 @@ bool prismChord(const ThreadContext::Beam& b, const Vec3& x, const Vec3& wi, flo
     return hi > lo;
 }
 
+// The density of directions towards the beam of `view` from x (solid
+// angle): per bin, its mass times the volume density 1 / (bin length x
+// cross-section area: pi tan^2 s^2 for a cone, constant for a prism)
+// integrated along the ray over the beam's part in the bin, with the
+// Jacobian t^2.
 double beamPdf(ThreadContext& ctx, const BeamView& view, const Vec3& x, const Vec3& wi) {
     const ThreadContext::Beam& b = *view.beam;
     float t0, t1;
