@@ -16,7 +16,6 @@ const Entry kEstimators[] = {
     {Method::Transmittance, makeTransmittanceMarcher},
     {Method::Guided, makeGuidedMarcher},
     {Method::Reference, makeReferenceTracer},
-    {Method::GuidedPath, makeGuidedPathTracer},
 };
 }  // namespace
 

@@ -1,6 +1,5 @@
 // One interface for every way of estimating the radiance along a camera ray
-// (the render's methods: the paper's three marchers, the path tracer and the
-// guided path tracer), and one factory table. Per-thread state lives in a
+// (the render's methods: the paper's three marchers and the path tracer), and one factory table. Per-thread state lives in a
 // ThreadContext.
 #pragma once
 
@@ -38,6 +37,5 @@ std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_pt
 std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
 std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
 std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il);
-std::unique_ptr<Estimator> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il);
 
 }  // namespace vdbmarch

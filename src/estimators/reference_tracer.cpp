@@ -10,12 +10,7 @@
 // caustic give them at the camera path's first medium vertex (eq. 4, the
 // progressive passes' radius), as they do at the guided marcher's L_i
 // samples; the paths give all the rest.
-//
-// Guided path tracing is the same loop with the radiance cache as its guide
-// (cache_path_guide.h): free flights, and with render.product_sampling
-// directions, drawn towards where the cache says the light is.
 #include "illumination/illumination.h"
-#include "estimators/cache_path_guide.h"
 #include "estimators/estimator.h"
 #include "transport/path_tracer.h"
 #include "transport/surface_event.h"
@@ -40,7 +35,6 @@ class ReferenceTracer final : public Estimator {
 public:
     ReferenceTracer(const Scene& s, std::shared_ptr<const Illumination> il = nullptr)
         : mScene(s), mChromatic(hasChromaticExtinction(s)), mIllumination(std::move(il)) {
-        if (mIllumination && mIllumination->cache) mGuide = makeCachePathGuide(s, *mIllumination->cache);
         if (mIllumination && mIllumination->causticsOnly) mCaustics = std::make_unique<CausticPhotons>(*mIllumination);
     }
 
@@ -48,7 +42,6 @@ public:
         ++ctx.counters.cameraRays;
         const int region = regionAtRayStart(mScene, cameraRay);
         PathState start;
-        start.guide = mGuide.get();
         start.firstVertexLight = mCaustics.get();
         if (!mChromatic) return tracePath(ctx, cameraRay, region, -1, rng, start);
         PathRadiance out{Color(0), 0.f, Color(0), Color(0)};
@@ -65,18 +58,13 @@ public:
 private:
     const Scene& mScene;
     const bool mChromatic;
-    std::shared_ptr<const Illumination> mIllumination;  // keeps the guide's cache alive
-    std::unique_ptr<PathGuide> mGuide;
+    std::shared_ptr<const Illumination> mIllumination;  // keeps the caustic photons alive
     std::unique_ptr<InScatteredLight> mCaustics;  // null where no caustic photons are traced
 };
 
 }  // namespace
 
 std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<ReferenceTracer>(scene, std::move(il));
-}
-
-std::unique_ptr<Estimator> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
     return std::make_unique<ReferenceTracer>(scene, std::move(il));
 }
 

@@ -61,7 +61,7 @@ public:
     SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il, bool guided)
         : SegmentMarcher(scene, std::move(il)),
           mGuided(guided && mIllumination->cache),
-          mLightShare(mGuided && scene.desc.render.volumeSampling != VolumeSampling::Distance ? LightDistanceShare
+          mLightShare(mGuided && scene.desc.experiments.volumeSampling != VolumeSampling::Distance ? LightDistanceShare
                                                                                               : 0.0) {
         if (mGuided) mMeanGuided = measureMeanGuided();
     }

@@ -22,9 +22,6 @@ SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumin
     mLastEventByNextEvent = !hasBendingGlass(scene);
     for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
-    mProductSampling = scene.desc.render.productSampling && mIllumination->li == LiSource::Path &&
-                       mIllumination->cache && mIllumination->cache->directionLobes &&
-                       !mIllumination->cache->cells.empty();
 }
 
 PathRadiance SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
@@ -151,20 +148,6 @@ CacheLookup& MarcherScratch::lookup(const RadianceCache& cache) {
     return *cacheLookup;
 }
 
-bool MarcherScratch::buildProductSampler(const RadianceCache& cache, const Vec3& x, const Vec3& rayDir,
-                                         const MediumPoint& mp, ScatterVertex& vertex) {
-    if (!productQuery) productQuery = std::make_unique<RadianceCache::Query>(cache);
-    const int64_t cell = productQuery->find(x);
-    if (cell < 0) return false;
-    // The non-direct incident radiance there: what the path can find
-    // beside next-event estimation (the direct light of delta lights is not
-    // in it: a path never finds that).
-    if (!productSampler.build(cache.preparedLobes[size_t(cell)], mp.phase, rayDir)) return false;
-    vertex.pathSampler = &productSampler;
-    vertex.pathPdf = [](const void* s, const Vec3& wi) { return static_cast<const ProductDirectionSampler*>(s)->pdf(wi); };
-    return true;
-}
-
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
                                   const MediumPoint& mp, Rng& rng, float pathProbability, float photonWeight) const {
     // The direct AOV: light scattered here once, when this is the camera
@@ -203,17 +186,13 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         return direct(directLight(ctx, region, vertex, rng, kLastEvent)) + photons();
     }
     static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::UnbiasedMarching, true, false};
-    // The continuation's direction: phase x cached radiance where the cache
-    // has a cell, else the phase. Next-event estimation weighs its sphere-
-    // light samples against that same density (MIS).
+    // The continuation's direction: as at the path tracer's vertices, a
+    // share of the directions towards spot and collimated beams
+    // (transport/beam_directions.h), else the phase. Next-event estimation
+    // weighs its sphere-light samples against that same density (MIS).
     ScatterVertex nextEventVertex = vertex;
-    const ProductDirectionSampler* product = nullptr;
-    if (mProductSampling && m.buildProductSampler(*mIllumination->cache, x, rayDir, mp, nextEventVertex))
-        product = &m.productSampler;
-    // Else, as at the path tracer's vertices, a share of the directions
-    // towards spot and collimated beams (transport/beam_directions.h).
     BeamMixture beams{&ctx, region, &nextEventVertex};
-    const bool beamDirections = !product && beams.attach(nextEventVertex, il.pointLightsByPhotons);
+    const bool beamDirections = beams.attach(nextEventVertex, il.pointLightsByPhotons);
     Color Li = direct(directLight(ctx, region, nextEventVertex, rng, kNextEvent));
     // Sphere lights through glass spheres too, weighed against the
     // continuation's own hits, and point and spot lights, whose photons
@@ -231,12 +210,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         Color weight(1 / std::min(1.f, pathProbability));
         float pdf = 0;
         Vec3 wi;
-        if (product) {
-            const ProductSample s = product->sample(u0, u1, u2);
-            wi = s.wi;
-            weight *= s.weight;
-            pdf = s.pdf;
-        } else if (beamDirections) {
+        if (beamDirections) {
             wi = beams.sample(rng, weight, pdf);
         } else {
             wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);

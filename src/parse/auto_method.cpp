@@ -36,8 +36,6 @@ Method chooseMethod(const SceneDesc& d, std::string& why) {
     // Multiple scattering in open media: the path tracer measured as good
     // as or better than the marchers at equal time (cloud_sun: guided 1.09x
     // its MSE; fig3b_spots 1.69x; fig4_caustic_sphere 1.88x).
-    // guided_path is never chosen: it measured worse at equal time than
-    // these choices on every class (docs/method.md, "The automatic method").
     why = "multiple scattering in open media";
     return Method::Reference;
 }

@@ -92,7 +92,7 @@ public:
     std::vector<GlassSphere> glassSpheres;
     // The caustics of delta lights through the scene's refracting glass are
     // found by sphere caustic connections (sphere_caustics.h), so no photon
-    // needs to carry them: render.sphere_caustics, every refracting surface
+    // needs to carry them: experiments.sphere_caustics, every refracting surface
     // one of glassSpheres, at least one delta light, every point or spot off
     // the spheres' surfaces (inside one or outside all), every collimated
     // quad outside them (directional lights always are).

@@ -359,7 +359,7 @@ double beamsPdf(ThreadContext& ctx, size_t n, ViewAt&& viewAt, const Vec3& x, co
 }  // namespace
 
 bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLights) {
-    if (!ctx.scene.desc.render.beamDirections || skipPointLights) return false;
+    if (!ctx.scene.desc.experiments.beamDirections || skipPointLights) return false;
     if (ctx.beamRegions.empty()) buildBeams(ctx);
     return !ctx.beamRegions[size_t(region)].beams.empty();
 }

@@ -1,6 +1,6 @@
 // Directions towards the beams of spot lights and collimated quads, mixed
 // with f's own sampling at the path tracer's medium and diffuse vertices and
-// at the marchers' L_i samples (render.beam_directions).
+// at the marchers' L_i samples (experiments.beam_directions).
 //
 // In a thin haze lit by beams, most of the light a path can still find is
 // in the beams (and on the floor patches they light); a phase- or
@@ -33,7 +33,7 @@ namespace vdbmarch {
 constexpr float BeamShare = 0.3f;
 
 // True when the beams of region `region` are sampled at its vertices:
-// render.beam_directions, a spot light whose distance sampling may pay
+// experiments.beam_directions, a spot light whose distance sampling may pay
 // there (light_distance.h) or a collimated quad that no blocking surface
 // separates from it, and bounded, thin scattering media (an optical depth
 // of at most 4 across their bounds at the densest extinction).

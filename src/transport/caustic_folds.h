@@ -56,7 +56,7 @@ private:
     int mCount = 0;
 };
 
-// True when the scene has folds at all (render.sphere_caustics, point-like
+// True when the scene has folds at all (experiments.sphere_caustics, point-like
 // or parallel lights outside glass spheres, Scene::deltaLightCaustics), made
 // on the thread's first call (ThreadContext::foldSurfaces).
 bool sceneHasCausticFolds(ThreadContext& ctx);

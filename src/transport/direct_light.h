@@ -19,8 +19,8 @@ struct ScatterVertex {
     const PhaseMixture* phase = nullptr;
     Vec3 n;  // surface only
     Color albedo{0, 0, 0};
-    // The path's own direction density when it does not sample f (product
-    // sampling, a later layer): MIS must weigh light samples against it.
+    // The path's own direction density when it does not sample f alone (a
+    // beam mixture, beam_directions.h): MIS weighs light samples against it.
     float (*pathPdf)(const void* sampler, const Vec3& wi) = nullptr;
     const void* pathSampler = nullptr;
 

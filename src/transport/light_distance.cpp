@@ -30,9 +30,8 @@ float gainThreshold(const Light& light) { return light.isSphere() ? 64.f : 2.f; 
 // The density with which delta tracking makes a scattering collision at t,
 // for the weights only: sigma_s of the tracked channel times the
 // transmittance of the region's constant media (gridded media count as
-// clear: see the header), or the guided flight's own density.
+// clear: see the header).
 float trackingDensity(ThreadContext& ctx, const LightDistanceSegment& seg, float t, const MediumPoint& mp) {
-    if (seg.guide) return seg.guide->flightDensity(ctx, t);
     float tau = 0;
     for (int mi : ctx.scene.regions[size_t(seg.region)].media) {
         float integral;
@@ -108,7 +107,7 @@ bool openToRegion(const Scene& scene, const Vec3& position, int region) {
 
 bool regionHasLightDistances(ThreadContext& ctx, int region, bool skipPointLights) {
     const Scene& scene = ctx.scene;
-    if (scene.desc.render.volumeSampling == VolumeSampling::Distance || scene.lights.empty()) return false;
+    if (scene.desc.experiments.volumeSampling == VolumeSampling::Distance || scene.lights.empty()) return false;
     if (ctx.lightDistanceCandidate.empty()) buildCandidates(ctx);
     const size_t nLights = scene.lights.size();
     for (size_t i = 0; i < nLights; ++i)
@@ -136,7 +135,7 @@ LightDistanceSegment prepareLightDistances(ThreadContext& ctx, int region, const
                                            bool skipPointLights) {
     ctx.lightDistances.clear();
     const Scene& scene = ctx.scene;
-    const VolumeSampling mode = scene.desc.render.volumeSampling;
+    const VolumeSampling mode = scene.desc.experiments.volumeSampling;
     LightDistanceSegment seg{ray, region, channel, mode == VolumeSampling::Equiangular};
     seg.tEnd = tEnd;
     if (!regionHasLightDistances(ctx, region, skipPointLights)) return seg;

@@ -17,14 +17,12 @@
 // tracking density in them is sigma_s(t) T(t) with T exact in constant media
 // and taken as 1 in gridded ones: an estimate of T is random, and a weight
 // must be a function of t alone. At the sample, T itself comes from ratio
-// tracking (unbiased). A guided free flight (path_guide.h) brings its own
-// collision density, a function of t alone too.
+// tracking (unbiased).
 #pragma once
 
 #include "core/rng.h"
 #include "transport/caustic_folds.h"
 #include "transport/media_point.h"
-#include "transport/path_guide.h"
 
 namespace vdbmarch {
 
@@ -34,14 +32,11 @@ struct LightDistanceSegment {
     Ray ray;
     int region;
     int channel;  // tracked channel, < 0 for grey extinction
-    // render.volume_sampling = "equiangular": the distance samples take all
+    // experiments.volume_sampling = "equiangular": the distance samples take all
     // of a light's single scattering where they can land (no MIS).
     bool equiangularOnly = false;
     bool active = false;  // some light has a sampler
     float tEnd = 0;
-    // The segment's free flight is the guide's (prepared): the collision
-    // density in the weights is then its flightDensity.
-    const PathGuide* guide = nullptr;
 };
 
 // Sets up the samplers of the segment: one per point-like or sphere light

@@ -9,7 +9,6 @@
 #include "transport/glass_splitting.h"
 #include "transport/light_distance.h"
 #include "transport/media_point.h"
-#include "transport/path_guide.h"
 #include "transport/roulette.h"
 #include "transport/sphere_caustics.h"
 #include "transport/surface_event.h"
@@ -34,7 +33,7 @@ DirectLightOptions nextEventOptions(const PathState& st, const float* lightWeigh
 // where Embree prunes most of its tree, and a path that passes them without
 // a collision goes on from there. Delta tracking is memoryless, so the cut
 // changes no distribution; it is made only where nothing else reads the
-// segment's end (no guided flight, no distance sampling towards lights).
+// segment's end (no distance sampling towards lights).
 constexpr float ProbeFreePaths = 3;
 float probeLength(ThreadContext& ctx, int region, int channel, const PathState& st) {
     const Region& r = ctx.scene.regions[size_t(region)];
@@ -107,15 +106,6 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
     };
     auto result = [&](float transmittance) { return PathRadiance{L, transmittance, direct, emitted}; };
     MediumPoint mp;
-    // Copies split from the path at a segment's collision: traced once the
-    // free flight's walk has returned (their own walks reuse the thread
-    // context's majorants and the guide's prepared segment).
-    struct SplitCopy {
-        Ray ray;
-        Color beta;
-        float pdf = 0;
-    };
-    std::array<SplitCopy, MaxSplitPaths - 1> copies;
     // Next-event estimation at a vertex of the path, and the connections to
     // sphere lights through glass spheres (sphere_caustics.h); true when
     // those were made (the path's own hits through a ball weigh against them).
@@ -131,22 +121,11 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         return true;
     };
     while (true) {
-        // A guide may take this segment's free flight (path_guide.h); at
-        // max_depth a collision could only end the path, so it is tracked.
-        // Guided roulette's pixel estimate needs the camera path's first
-        // segment prepared even where flights stay with delta tracking.
-        const bool wantEstimate = st.guide && startDepth == 0 && !(st.windowReference > 0) && st.guide->guidesRoulette();
-        const bool flights = st.guide && st.depth < maxDepth && st.guide->guidesFlights(region);
-
-        const RaySegment seg =
-            nextRaySegment(scene, ray, flights || wantEstimate ? Infinity : probeLength(ctx, region, channel, st));
+        const RaySegment seg = nextRaySegment(scene, ray, probeLength(ctx, region, channel, st));
         const SurfaceHit& h = seg.surface;
         const bool hit = seg.hitSurface;
         const int light = seg.light;
         const float tEnd = seg.tEnd;
-
-        const bool prepared = (flights || wantEstimate) && st.guide->prepareFlight(ctx, region, ray, tEnd, channel);
-        const bool guided = prepared && flights;
 
         // Distance sampling towards point, spot and sphere lights along the
         // segment, weighed against the collisions' next-event estimates by
@@ -154,15 +133,6 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         LightDistanceSegment lightDistances =
             st.depth < maxDepth ? prepareLightDistances(ctx, region, ray, tEnd, channel, st.pointLightsByPhotons)
                                 : LightDistanceSegment{};
-        if (guided) lightDistances.guide = st.guide;
-        // The pixel's estimate for guided roulette: what the guide expects
-        // the camera path's first segment through media to bring back.
-        if (prepared && wantEstimate) {
-            const FlightEstimate e = st.guide->flightEstimate(ctx);
-            double I = e.inScattered;
-            if (!hit && light < 0) I += e.transmittance * double(average(scene.environment.radianceSeen(ray.d)));
-            st.windowReference = float(double(average(beta)) * I);
-        }
         if (lightDistances.active) add(beta * sampleLightDistances(ctx, lightDistances, rng), st.depth + 1);
         // And near the folds of caustics behind glass spheres that the
         // segment crosses, where connected light grows as 1 / sqrt(distance).
@@ -170,11 +140,8 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
         if (st.depth < maxDepth && prepareFoldDistances(ctx, region, ray, tEnd, folds))
             add(beta * sampleFoldDistances(ctx, lightDistances, folds, !st.pointLightsByPhotons, rng), st.depth + 1);
 
-        int numCopies = 0;  // of `copies`, split at this segment's collision
-        bool windowed = false;  // roulette was decided by the weight window
-
         // A real scattering event at x (media mp there): next-event
-        // estimation, then the next direction (the guide's or the phase's).
+        // estimation, then the next direction.
         // False when max_depth ends the path.
         auto scatterAt = [&](Vec3 x, float t, const MediumPoint& mp) {
             if (++st.depth > maxDepth) {
@@ -188,11 +155,10 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 if (moved != t) t = moved, x = ray.at(t);
             }
             ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
-            const bool guidedDirection = st.guide && st.guide->prepareDirection(ctx, x, ray.d, mp, vertex);
-            // Or a share of the directions towards spot and collimated beams
+            // A share of the directions towards spot and collimated beams
             // (beam_directions.h).
             BeamMixture beams{&ctx, region, &vertex};
-            const bool beamDirections = !guidedDirection && beams.attach(vertex, st.pointLightsByPhotons);
+            const bool beamDirections = beams.attach(vertex, st.pointLightsByPhotons);
             const float* weights = lightDistances.active ? trackingWeights(ctx, lightDistances, t, mp) : nullptr;
             const float deltaWeight = foldTrackingWeight(ctx, lightDistances, folds, t, mp);
             const bool caustics = nextEvent(vertex, weights, deltaWeight);
@@ -200,54 +166,23 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 add(beta * st.firstVertexLight->at(x, region, -ray.d, mp.phase), st.depth);
                 st.firstVertexLight = nullptr;
             }
-            // Guided roulette and splitting of what follows the vertex.
-            int paths = 1;
-            if (st.windowReference > 0) {
-                const float r = average(beta) * st.guide->expectedRadiance(ctx, x, -ray.d) / st.windowReference;
-                const WindowDecision d = weightWindow(r, rng.uniform(), st.splitLimit);
-                windowed = true;
-                if (d.paths == 0) {
-                    beta = Color(0);
-                    return false;
-                }
-                beta *= d.weight;
-                paths = d.paths;
-                st.splitLimit = std::max(1, st.splitLimit / paths);
-            }
-            // The next direction (the guide's or the phase's), for the path
-            // and for each copy split from it.
-            auto sampleDirection = [&](Color& b, float& pdf) {
-                if (beamDirections) return beams.sample(rng, b, pdf);
-                const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-                if (!guidedDirection) return mp.phase.sample(ray.d, u0, u1, u2, b, pdf);
-                Color w(0);
-                const Vec3 wi = st.guide->sampleDirection(ctx, u0, u1, u2, w, pdf);
-                b *= pdf > 0 ? w : Color(0);
-                return wi;
-            };
-            for (int k = 1; k < paths; ++k) {
-                SplitCopy& c = copies[size_t(numCopies++)];
-                c.beta = beta;
-                c.ray.o = x;
-                c.ray.d = sampleDirection(c.beta, c.pdf);
-            }
+            // The next direction: the beams' mixture or the phase's.
             float pdf = 0;
-            const Vec3 wi = sampleDirection(beta, pdf);
-            if (beamDirections || guidedDirection) scaleRoulette(st, vertex, wi, pdf);
+            Vec3 wi;
+            if (beamDirections) {
+                wi = beams.sample(rng, beta, pdf);
+                scaleRoulette(st, vertex, wi, pdf);
+            } else {
+                const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+                wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
+            }
             startVertex(st, x, wi, pdf, caustics);
             ray = Ray{x, wi};
             return true;
         };
 
         bool scattered = false;
-        if (guided) {
-            const GuidedFlight flight = st.guide->sampleFlight(ctx, rng, mp);
-            beta *= flight.weight;
-            if (flight.scattered && !isBlack(beta)) {
-                ++ctx.counters.marchSamples;
-                scattered = scatterAt(ray.at(flight.t), flight.t, mp);
-            }
-        } else {
+        {
             // Delta tracking to the next real collision, or to tEnd; the
             // collision callback returns false once the path scattered or
             // was absorbed.
@@ -269,19 +204,9 @@ PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng
                 return false;
             });
         }
-        for (int k = 0; k < numCopies; ++k) {
-            const SplitCopy& c = copies[size_t(k)];
-            PathState cs = st;
-            cs.lastPdf = c.pdf;
-            cs.lastDir = c.ray.d;
-            const PathRadiance r = tracePath(ctx, c.ray, region, channel, rng, cs);
-            L += c.beta * r.L;
-            direct += c.beta * r.direct;
-            emitted += c.beta * r.emitted;
-        }
         if (isBlack(beta)) return result(0.f);
         if (scattered) {
-            if (!windowed && !roulette(beta, st, rng)) return result(0.f);
+            if (!roulette(beta, st, rng)) return result(0.f);
             continue;
         }
         // Reached tEnd without a real collision.

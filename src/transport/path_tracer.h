@@ -8,11 +8,8 @@
 //  - next-event estimation to every light at every scattering vertex with
 //    unbiased ray-marching transmittance; sphere lights are also hit by the
 //    path and the two strategies meet by the power heuristic;
-//  - with a guide (path_guide.h), its free flights and directions instead
-//    wherever it takes them;
 //  - phase-mixture sampling, the shared surface event, Russian roulette
-//    after RouletteMinDepth events (with a guide that steers roulette, at
-//    every medium vertex by its weight window, splitting too); max_depth counts scattering events
+//    after RouletteMinDepth events; max_depth counts scattering events
 //    (media and diffuse surfaces).
 // Media whose extinction differs between RGB channels are tracked one
 // channel per path (`channel` >= 0), which keeps every estimator unbiased;
@@ -25,7 +22,6 @@
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
-class PathGuide;
 struct PhaseMixture;
 
 // Light a path cannot find, estimated by a layer above this one and added
@@ -51,21 +47,12 @@ struct PathState {
     // Next-event estimation leaves point and spot lights out (photons carry
     // their multiply scattered light: near them it has unbounded variance).
     bool pointLightsByPhotons = false;
-    // Free flights and medium directions by this guide where it takes them
-    // (path_guide.h); null: delta tracking and phase sampling.
-    const PathGuide* guide = nullptr;
     // Added at the next medium vertex, then cleared (InScatteredLight).
     const InScatteredLight* firstVertexLight = nullptr;
-    // Guided roulette and splitting (roulette.h, weightWindow): the pixel's
-    // estimate from the guide, set on the camera path's first guided segment
-    // (0: roulette by throughput), and how many paths this one may still
-    // split into.
-    float windowReference = 0;
-    int splitLimit = MaxSplitPaths;
     // Roulette by throughput judges a path by beta x rouletteScale: the
     // throughput it would carry had every vertex sampled f alone. A
-    // direction drawn towards a spot beam (beam_directions.h) or by the
-    // guide's product sampler carries the small weight f / pdf because it
+    // direction drawn towards a spot beam (beam_directions.h) carries the
+    // small weight f / pdf because it
     // went where the light is, and roulette by beta alone ended most such
     // paths before their next segment found that light.
     float rouletteScale = 1;
@@ -109,7 +96,7 @@ struct PathRadiance {
 PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state);
 
 // A direction wi of density pdf drawn at vertex v by a sampler other than
-// f's own (a beam mixture, the guide's product sampler): scales the
+// f's own (a beam mixture): scales the
 // state's roulette to what f's own sampling would have left the throughput
 // (PathState::rouletteScale).
 void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf);

@@ -606,7 +606,7 @@ bool causticFoldPoint(const GlassSphere& s, const Light& light, double u, double
 }
 
 bool sceneHasSphereCaustics(const Scene& scene) {
-    return (scene.hasSphereLights || scene.deltaLightCaustics) && scene.desc.render.sphereCaustics &&
+    return (scene.hasSphereLights || scene.deltaLightCaustics) && scene.desc.experiments.sphereCaustics &&
            !scene.glassSpheres.empty();
 }
 

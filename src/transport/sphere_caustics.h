@@ -164,7 +164,7 @@ bool causticFold(const GlassSphere& s, const Light& light, CausticFold& out);
 // false where there is none.
 bool causticFoldPoint(const GlassSphere& s, const Light& light, double u, double& z, double& rho);
 
-// True when sphere caustic connections apply (render.sphere_caustics, a
+// True when sphere caustic connections apply (experiments.sphere_caustics, a
 // sphere light or Scene::deltaLightCaustics, a glass sphere): every vertex
 // then makes them, through each sphere by where it and the light lie, so a
 // path's weights (sphereCausticPathWeight) know what its last vertex did.

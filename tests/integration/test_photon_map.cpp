@@ -308,7 +308,7 @@ TEST(PhotonTracing, ConnectedPhotonsAreTheCausticsTheConnectionsFind) {
 
     const IlluminationRequest rq = illuminationRequest(*scene, Method::Guided);
     EXPECT_TRUE(rq.exceptConnected);
-    const auto off = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {"render.sphere_caustics=false"}));
+    const auto off = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {"experiments.sphere_caustics=false"}));
     EXPECT_FALSE(off->deltaLightCaustics);
     EXPECT_FALSE(illuminationRequest(*off, Method::Guided).exceptConnected);
     for (const Photon& p : tracePhotons(*off, 20000, 5).photons) EXPECT_FALSE(p.isConnected());

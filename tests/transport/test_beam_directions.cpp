@@ -35,7 +35,7 @@ const char* const kBeamScene = R"({
      "direction": [0.2, -1, -0.1], "irradiance": [3, 3, 3]}],
   "media": [{"name": "haze", "type": "homogeneous", "sigma_a": 0.02, "sigma_s": 0.3, "g": 0.5,
              "bounds": {"min": [-1.5, -1, -1], "max": [1.5, 1, 1]}}],
-  "render": {"method": "reference", "beam_directions": true}
+  "render": {"method": "reference"}, "experiments": {"beam_directions": true}
 })";
 
 using test::fromZPhi;
