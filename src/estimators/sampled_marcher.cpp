@@ -31,7 +31,8 @@
 #include <cmath>
 
 #include "estimators/segment_marcher.h"
-#include "transport/light_distance.h"
+#include "strategies/caustic_folds.h"
+#include "strategies/light_distances.h"
 #include "transport/roulette.h"
 
 namespace vdbmarch {
@@ -58,8 +59,9 @@ constexpr double FoldDistanceShare = 0.15;
 
 class SampledMarcher final : public SegmentMarcher {
 public:
-    SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il, bool guided)
-        : SegmentMarcher(scene, std::move(il)),
+    SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                   std::shared_ptr<const StrategySet> strategies, bool guided)
+        : SegmentMarcher(scene, std::move(il), std::move(strategies)),
           mGuided(guided && mIllumination->cache),
           mLightShare(mGuided && scene.desc.experiments.volumeSampling != VolumeSampling::Distance ? LightDistanceShare
                                                                                               : 0.0) {
@@ -202,11 +204,14 @@ private:
                 // prepare their own in the same ThreadContext.
                 auto& lights = m.lightDistances;
                 lights.clear();
-                if (mLightShare > 0 && prepareLightDistances(ctx, region, ray, tEnd, -1, false).active)
-                    lights = ctx.lightDistances;
+                const StrategySet& strategies = mPaths.strategies();
+                if (mLightShare > 0 &&
+                    strategies.lightDistances().prepare(ctx, PathSegment{ray, region, -1, tEnd, false}))
+                    lights = strategies.lightDistances().prepared(ctx);
                 const double a = lights.empty() ? 0.0 : mLightShare;
                 FoldSampler& folds = m.foldDistances;
-                const bool crossesFolds = mLightShare > 0 && prepareFoldDistances(ctx, region, ray, tEnd, folds);
+                const bool crossesFolds =
+                    mLightShare > 0 && strategies.causticFolds().crossings(region, ray, tEnd, folds);
                 const RayPdf::Mixture mixture{a, &lights, crossesFolds ? FoldDistanceShare : 0.0, &folds};
                 MediumPoint ms;
                 // The caustic photons at one of the n samples, drawn uniformly
@@ -249,12 +254,14 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<SampledMarcher>(scene, std::move(il), false);
+std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                                    std::shared_ptr<const StrategySet> strategies) {
+    return std::make_unique<SampledMarcher>(scene, std::move(il), std::move(strategies), false);
 }
 
-std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<SampledMarcher>(scene, std::move(il), true);
+std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                             std::shared_ptr<const StrategySet> strategies) {
+    return std::make_unique<SampledMarcher>(scene, std::move(il), std::move(strategies), true);
 }
 
 }  // namespace vdbmarch

@@ -29,7 +29,7 @@ struct MarcherScratch final : ThreadContextExtension {
     std::vector<float> stepH;
     MediumPoint walkMedia[WalkBatch];  // the media of the walk's next steps
     RayPdf rayPdf;
-    std::vector<ThreadContext::LightDistance> lightDistances;  // guided: the segment's equiangular samplers
+    std::vector<LightDistance> lightDistances;  // guided: the segment's equiangular samplers
     FoldSampler foldDistances;  // guided: the segment's crossings of caustic folds
     std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
     // The guided marcher's probe of eq. 17's scale: march without sampling
@@ -52,7 +52,8 @@ struct MarcherScratch final : ThreadContextExtension {
 
 class SegmentMarcher : public Estimator {
 public:
-    SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination);
+    SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination,
+                   std::shared_ptr<const StrategySet> strategies);
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
 
 private:
@@ -121,6 +122,7 @@ protected:
     const bool mChromatic;  // continuation paths track one channel
     const bool mTallyDirect;  // render.aovs asks for direct or indirect
     bool mLastEventByNextEvent = true;  // see the constructor
+    PathTracer mPaths;  // continuation paths, with the render's strategies
 };
 
 // One step of length dx in a medium with extinction kappa: its transmittance,

@@ -83,7 +83,7 @@ const std::vector<std::string>& aovNames();
 // How free flights in media find point, spot and sphere lights (Cycles'
 // "volume sampling"): by transmittance alone (delta tracking), by distance
 // sampling towards each light (equiangular) alone, or by both weighed by
-// multiple importance sampling (transport/light_distance.h).
+// multiple importance sampling (strategies/light_distances.h).
 enum class VolumeSampling { Distance, Equiangular, Mis };
 
 struct RenderSettings {
@@ -119,14 +119,14 @@ struct RenderSettings {
 struct ExperimentSettings {
     VolumeSampling volumeSampling = VolumeSampling::Mis;
     // Path vertices connect to sphere lights through glass spheres
-    // (transport/sphere_caustics.h), weighed by MIS against the path's hits.
+    // (strategies/sphere_caustics.h), weighed by MIS against the path's hits.
     bool sphereCaustics = true;
     // Medium vertices draw a share of their directions towards spot and
-    // collimated beams (transport/beam_directions.h).
+    // collimated beams (strategies/beam_directions.h).
     bool beamDirections = true;
     // Camera paths follow both outcomes of their first glass event, and
     // every other glass event counts the light its reflection sees
-    // (transport/glass_splitting.h).
+    // (strategies/glass_splitting.h).
     bool glassSplitting = true;
     // Adaptive sampling in timed renders (render --time): blocks of pixels
     // whose share of the time left is spent stop receiving samples

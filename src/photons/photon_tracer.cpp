@@ -11,9 +11,8 @@
 #include "core/memory.h"
 #include "core/sampling.h"
 #include "transport/media_point.h"
-#include "transport/path_tracer.h"
 #include "transport/roulette.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
 

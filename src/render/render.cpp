@@ -598,9 +598,12 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // comparison charges the guided marcher for its cache.
     std::shared_ptr<Illumination> illumination;
     std::unique_ptr<Estimator> marcher;
+    // The sampling strategies and their tables, once per render.
+    const std::shared_ptr<const StrategySet> strategies =
+        options.strategies ? options.strategies : StrategySet::build(scene);
     arena.execute([&] {
         illumination = std::make_shared<Illumination>(buildIllumination(scene, request));
-        marcher = makeEstimator(rs.method, scene, illumination);
+        marcher = makeEstimator(rs.method, scene, illumination, strategies);
     });
     const double firstIlluminationSeconds = illumination->stats.seconds;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
@@ -695,7 +698,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             if (pass != illumination->photonPass) {
                 arena.execute([&] {
                     if (photonPasses.advance(scene, pass, *illumination))
-                        marcher = makeEstimator(rs.method, scene, illumination);
+                        marcher = makeEstimator(rs.method, scene, illumination, strategies);
                 });
             }
             const int end = std::min(s1, photonPasses.progressive() ? photonPasses.firstSampleOf(pass + 1) : s1);

@@ -57,7 +57,7 @@ bool mayBeInside(const Scene& scene, const Vec3& p, const std::vector<int>& arou
 }
 
 // The spheres of refracting glass, uniformly scaled, that next-event
-// estimation sees light through (transport/sphere_caustics.h), empty or
+// estimation sees light through (strategies/sphere_caustics.h), empty or
 // holding a medium.
 void findGlassSpheres(Scene& scene) {
     for (size_t i = 0; i < scene.desc.surfaces.size(); ++i) {

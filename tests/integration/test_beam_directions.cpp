@@ -1,5 +1,5 @@
 // Directions towards spot and collimated beams in the path tracer
-// (transport/beam_directions.h): renders with experiments.beam_directions on must
+// (strategies/beam_directions.h): renders with experiments.beam_directions on must
 // agree with renders whose vertices sample f alone (off), region by region
 // within 4 standard errors of the paired difference: the paper's spot scene
 // (haze and a diffuse floor), a spot inside two overlapping hazes of

@@ -1,4 +1,4 @@
-// Distance sampling towards lights (transport/light_distance.h) in the path
+// Distance sampling towards lights (strategies/light_distances.h) in the path
 // tracer: every experiments.volume_sampling mode against numerical quadrature of
 // single scattering from a point and a spot light inside a homogeneous box,
 // and the three modes against one another on a heterogeneous VDB cloud with

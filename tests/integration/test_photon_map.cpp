@@ -16,7 +16,7 @@
 #include "photons/photon_map.h"
 #include "photons/photon_tracer.h"
 #include "illumination/illumination.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
 #include "support/support.h"
 
 namespace vdbmarch {

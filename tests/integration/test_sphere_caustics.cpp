@@ -1,4 +1,4 @@
-// Sphere caustic connections in the path tracer (transport/sphere_caustics.h):
+// Sphere caustic connections in the path tracer (strategies/sphere_caustics.h):
 // renders with experiments.sphere_caustics on must agree with renders where the
 // paths alone find the light through the glass (off), region by region
 // within 4 standard errors of the paired difference: the paper's caustic
@@ -28,7 +28,7 @@
 
 #include "illumination/illumination.h"
 #include "photons/photon_tracer.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
 #include "support/support.h"
 
 namespace vdbmarch {

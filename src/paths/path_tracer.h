@@ -5,24 +5,27 @@
 //    media: exact exponential sampling), emission of eq. 1 collected at every
 //    tentative collision (sigma_a L_e / sigma_maj), absorption / scattering /
 //    null chosen by their ratios;
+//  - the render's sampling strategies (strategies/strategy.h), iterated in
+//    the set's order: distance samples along each segment, directions at
+//    each vertex, connections through specular surfaces;
 //  - next-event estimation to every light at every scattering vertex with
 //    unbiased ray-marching transmittance; sphere lights are also hit by the
-//    path and the two strategies meet by the power heuristic;
-//  - phase-mixture sampling, the shared surface event, Russian roulette
-//    after RouletteMinDepth events; max_depth counts scattering events
-//    (media and diffuse surfaces).
+//    path and the strategies meet by the power heuristic;
+//  - the shared surface event, Russian roulette after RouletteMinDepth
+//    events; max_depth counts scattering events (media and diffuse surfaces).
 // Media whose extinction differs between RGB channels are tracked one
 // channel per path (`channel` >= 0), which keeps every estimator unbiased;
 // grey-extinction media share one path with RGB weights (channel < 0).
 #pragma once
 
+#include <memory>
+
 #include "core/rng.h"
+#include "strategies/strategy_set.h"
 #include "transport/direct_light.h"
-#include "transport/roulette.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
-struct PhaseMixture;
 
 // Light a path cannot find, estimated by a layer above this one and added
 // once, at a path's first medium vertex: the caustics of delta lights through
@@ -34,45 +37,28 @@ public:
     virtual ~InScatteredLight() = default;
     virtual Color at(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const = 0;
 };
-}
-
-namespace vdbmarch {
 
 // Where a path stands when the loop takes it over.
 struct PathState {
     int depth = 0;           // scattering events so far
+    int surfaceBounces = 0;  // surfaces met (render.max_surface_bounces)
     bool specular = true;    // the last direction was not sampled from a density (no MIS)
     float lastPdf = 0;       // solid-angle pdf of that direction
     Vec3 lastPoint{0, 0, 0};  // where it was sampled
-    // Next-event estimation leaves point and spot lights out (photons carry
-    // their multiply scattered light: near them it has unbounded variance).
-    bool pointLightsByPhotons = false;
-    // Added at the next medium vertex, then cleared (InScatteredLight).
-    const InScatteredLight* firstVertexLight = nullptr;
-    // Roulette by throughput judges a path by beta x rouletteScale: the
-    // throughput it would carry had every vertex sampled f alone. A
-    // direction drawn towards a spot beam (beam_directions.h) carries the
-    // small weight f / pdf because it
-    // went where the light is, and roulette by beta alone ended most such
-    // paths before their next segment found that light.
+    Vec3 lastDir{0, 0, 1};    // the direction sampled there
+    // Roulette judges the path by beta x rouletteScale: the throughput it
+    // would carry had every vertex sampled f alone (scaleRoulette).
     float rouletteScale = 1;
-    // Sphere caustic connections (sphere_caustics.h) were made at lastPoint,
-    // and the refractions since then at one glass sphere: a sphere light
-    // hit after one (across its surface) or two (in and out) takes the MIS
-    // weight against them. -1 in lensSphere: none yet; lensRefractions < 0: another event
-    // broke the pattern.
-    bool causticsAtLast = false;
-    Vec3 lastDir{0, 0, 1};  // the direction sampled at lastPoint
-    int lensSphere = -1;
-    int lensRefractions = 0;
-    // Surfaces met (render.max_surface_bounces), and glass events whose two
-    // outcomes the path followed both (SplitDielectricEvents).
-    int surfaceBounces = 0;
-    int glassSplits = 0;
+    // Connection strategies made connections at lastPoint, and the specular
+    // events since: a light the path hits through them weighs against those.
+    bool connectedAtLast = false;
+    SpecularChain chain;
+    int glassSplits = 0;  // glass events whose two outcomes the path followed (SplitDielectricEvents)
     // The light or background the last glass reflection's ray meets first
-    // was counted at the glass (mirroredLight in path_tracer.cpp): the path
-    // that took that reflection must not count it again.
+    // was counted at the glass (glass_splitting.h): not again.
     bool mirrorCounted = false;
+    // PathOptions::firstVertexLight is still to be added.
+    bool firstVertexPending = true;
 };
 
 // What a path brings back: a camera path's result (Estimator::radiance) and a
@@ -92,20 +78,39 @@ struct PathRadiance {
     Color emitted;
 };
 
-// The radiance the path ray (in `region`) brings back, from `state`.
-PathRadiance tracePath(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state);
+// What the estimator above sets once for all its paths.
+struct PathOptions {
+    // Next-event estimation and distance sampling leave point and spot
+    // lights out: photons carry their multiply scattered light (near them
+    // next-event estimation has unbounded variance).
+    bool pointLightsByPhotons = false;
+    // Added at a path's first medium vertex (null: nothing).
+    const InScatteredLight* firstVertexLight = nullptr;
+};
+
+class PathTracer {
+public:
+    PathTracer(const Scene& scene, std::shared_ptr<const StrategySet> strategies, PathOptions options = {});
+
+    // The radiance the path ray (in `region`) brings back, from `state`.
+    PathRadiance trace(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state) const;
+
+    const Scene& scene() const { return mScene; }
+    const StrategySet& strategies() const { return *mStrategies; }
+    const PathOptions& options() const { return mOptions; }
+    // The first direction strategy that takes vertex v (null: f's own sampling).
+    const DirectionStrategy* attachDirections(ThreadContext& ctx, int region, ScatterVertex& v) const;
+
+private:
+    friend class PathWalk;
+    const Scene& mScene;
+    std::shared_ptr<const StrategySet> mStrategies;
+    PathOptions mOptions;
+};
 
 // A direction wi of density pdf drawn at vertex v by a sampler other than
-// f's own (a beam mixture): scales the
-// state's roulette to what f's own sampling would have left the throughput
-// (PathState::rouletteScale).
+// f's own (a direction strategy): scales the state's roulette to what f's
+// own sampling would have left the throughput (PathState::rouletteScale).
 void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf);
-
-// True when some medium's extinction differs between channels.
-bool hasChromaticExtinction(const Scene& scene);
-
-// Tracking probabilities of the channel, or for grey extinction the channel
-// average (sigma_a + sigma_s sums to sigma_t either way).
-inline float trackedOrAverage(const Color& c, int channel) { return channel < 0 ? average(c) : c[channel]; }
 
 }  // namespace vdbmarch

@@ -1,4 +1,4 @@
-#include "transport/glass_splitting.h"
+#include "strategies/glass_splitting.h"
 
 #include "transport/transmittance.h"
 

@@ -22,34 +22,31 @@
 // same density by MIS (ScatterVertex::pathPdf).
 #pragma once
 
+#include <map>
+#include <vector>
+
 #include "core/math.h"
 #include "core/rng.h"
-#include "transport/direct_light.h"
-#include "transport/thread_context.h"
+#include "strategies/strategy.h"
 
 namespace vdbmarch {
+
+class LightDistances;
+class BeamDirections;
 
 // The share of the beams in the mixture.
 constexpr float BeamShare = 0.3f;
 
-// True when the beams of region `region` are sampled at its vertices:
-// experiments.beam_directions, a spot light whose distance sampling may pay
-// there (light_distance.h) or a collimated quad that no blocking surface
-// separates from it, and bounded, thin scattering media (an optical depth
-// of at most 4 across their bounds at the densest extinction).
-bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLights);
-
-// The density (solid angle) of a direction drawn towards the region's
-// beams from x (no phase share).
-float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi);
-
 // A vertex's direction sampler: f's own sampling (the phase function, or
-// the cosine on a diffuse surface) mixed with the beams.
+// the cosine on a diffuse surface) mixed with the beams of its region.
 struct BeamMixture {
-    BeamMixture(ThreadContext* c, int r, const ScatterVertex* v) : ctx(c), region(r), vertex(v) {}
-    ThreadContext* ctx;
-    int region;
-    const ScatterVertex* vertex;
+    BeamMixture() = default;
+    BeamMixture(ThreadContext* c, const BeamDirections* b, int r, const ScatterVertex* v)
+        : ctx(c), beams(b), region(r), vertex(v) {}
+    ThreadContext* ctx = nullptr;
+    const BeamDirections* beams = nullptr;
+    int region = 0;
+    const ScatterVertex* vertex = nullptr;
 
     // wi, f / pdf per channel (f cos on a surface) and the mixture's pdf;
     // pdf 0 (weight 0): no direction.
@@ -75,16 +72,57 @@ struct BeamMixture {
     mutable double mBeamWeight = -1;  // beamWeight(); < 0 until the sights are made
     // For ScatterVertex::pathPdf.
     static float pdfOf(const void* self, const Vec3& wi) { return static_cast<const BeamMixture*>(self)->pdf(wi); }
+};
 
-    // True when `region` samples beams (regionHasBeamDirections); then the
-    // vertex's path density is this mixture's (next-event MIS meets it).
-    bool attach(ScatterVertex& v, bool skipPointLights) {
-        if (!regionHasBeamDirections(*ctx, region, skipPointLights)) return false;
-        vertex = &v;
-        v.pathPdf = &BeamMixture::pdfOf;
-        v.pathSampler = this;
-        return true;
-    }
+// The beams of spot lights (cones) and collimated quads (prisms) that each
+// region's medium vertices draw directions towards, built once per render.
+// A region has them with experiments.beam_directions, a spot light whose
+// distance sampling may pay there (light_distances.h) or a collimated quad
+// that no blocking surface separates from it, and bounded, thin scattering
+// media (an optical depth of at most 4 across their bounds at the densest
+// extinction).
+class BeamDirections final : public DirectionStrategy {
+public:
+    BeamDirections(const Scene& scene, const LightDistances& distances, size_t slot);
+
+    struct Beam {
+        int light;
+        Vec3 apex, axis, e1, e2;  // a prism's "apex" is its quad's centre
+        float tanCone = 0;
+        float s0, s1;     // the axial range sampled (the region's media)
+        float power = 1;  // scattered power per unit length of beam
+        // A collimated quad's prism: the quad's edges u, v and their axial
+        // parts, the dual vectors that give a point's quad coordinates
+        // (|a|, |b| <= 1/2 inside) along the beam, and the cross-section's
+        // area perpendicular to the axis.
+        bool prism = false;
+        Vec3 u, v, dualA, dualB;
+        float uAxial = 0, vAxial = 0, area = 0;
+    };
+    struct Region {
+        std::vector<Beam> beams;
+        // The integral of the media's phase function over the scattering
+        // angle, G(theta) = int_0^theta p(cos a) da, at BeamAngleSteps + 1
+        // angles over [0, pi] (shared by the regions of one g).
+        const std::vector<float>* angleIntegral = nullptr;
+    };
+    const Region& region(int r) const { return mRegions[size_t(r)]; }
+    bool hasBeams(int r, bool skipPointLights) const { return !skipPointLights && !mRegions[size_t(r)].beams.empty(); }
+
+    bool attach(ThreadContext& ctx, int region, ScatterVertex& v, bool skipPointLights) const override;
+    Vec3 sample(ThreadContext& ctx, Rng& rng, Color& weight, float& pdf) const override;
+
+    // The density (solid angle) of a direction drawn towards the region's
+    // beams from x (no phase share).
+    float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi) const;
+
+private:
+    struct Scratch final : ThreadContextExtension {
+        BeamMixture mixture;  // the attached vertex's
+    };
+    std::vector<Region> mRegions;
+    std::map<float, std::vector<float>> mAngleIntegrals;  // per g
+    const size_t mSlot;
 };
 
 }  // namespace vdbmarch
