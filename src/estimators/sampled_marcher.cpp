@@ -101,8 +101,10 @@ private:
     // rather than at each: with render.li = "path" where the map holds
     // caustics alone. Not the multiply scattered light of point and spot
     // lights (pointLightsByPhotons), which varies along a ray as 1 / d^2
-    // near the light: one gather per segment doubled exp1_point's MSE at
-    // 16 s. Nor the paper's "photons", which gathers at every sample.
+    // near the light, so one gather weighted by n has far more variance
+    // (measured: docs/benchmarks/history.md, "Photons gathered within their
+    // medium region"). Nor the paper's "photons", which gathers at every
+    // sample.
     bool gathersOncePerSegment() const {
         const Illumination& il = *mIllumination;
         return il.li == LiSource::Path && il.indirect && !il.pointLightsByPhotons;
@@ -127,7 +129,7 @@ private:
         // intervals, the medium taken at one jittered point per step. The
         // media of WalkBatch steps are looked up first, in a loop of
         // independent lookups the core can overlap (a lookup's latency is
-        // about 2.4x its throughput), then the steps are taken in order.
+        // a few times its throughput), then the steps are taken in order.
         // Roulette may end the walk inside a batch: the rest were looked up
         // for nothing, never used (the pixels are those of a step-by-step
         // walk).

@@ -13,12 +13,12 @@ namespace vdbmarch {
 namespace {
 
 // A free flight in a region of constant media seldom goes far where they
-// are dense (exp1_sphere's milk: a mean free path of 0.02 in a knot of size
-// 1): the surface is looked for only within ProbeFreePaths mean free paths,
-// where Embree prunes most of its tree, and a path that passes them without
-// a collision goes on from there. Delta tracking is memoryless, so the cut
-// changes no distribution; it is made only where no distance strategy reads
-// the segment's end.
+// are dense (milk sealed in glass: mean free paths far shorter than the
+// glass): the surface is looked for only within ProbeFreePaths mean free
+// paths, where Embree prunes most of its tree, and a path that passes them
+// without a collision goes on from there. Delta tracking is memoryless, so
+// the cut changes no distribution; it is made only where no distance
+// strategy reads the segment's end.
 constexpr float ProbeFreePaths = 3;
 
 // A new vertex at x from which the path samples its next direction: its

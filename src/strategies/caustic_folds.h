@@ -9,8 +9,8 @@
 // as 1 / sqrt(d): integrable along a ray, but a position drawn by a density
 // that stays bounded there (the histogram, transmittance, equiangular
 // sampling) has weights with a tail as heavy as P(w > v) ~ 1 / v^2, the
-// variance of a log-divergent integral. On fig4_caustic (the paper's figure
-// 4) one such sample in 44 spp made a pixel 10x its value.
+// variance of a log-divergent integral: rare draws near a fold show as
+// fireflies.
 //
 // So a segment that crosses a fold also draws positions near each crossing
 // t_f with the density 1 / (4 sqrt(W |t - t_f|)) over [t_f - W, t_f + W]

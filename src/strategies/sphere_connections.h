@@ -30,9 +30,9 @@ constexpr int MaxSphereConnections = 8;
 // so a missed root only moves weight to them; a point light has no other
 // way, so `thorough` also finds pairs between the grid's points (at local
 // minima of |h|), the arc's ends and a finer grid near the axis
-// (SphereCaustics.TheSolverFindsEveryTracedPathFromAPoint: without these,
-// 0.8 % of a point light's paths through the ball were missed); with every
-// solve thorough, fig4_caustic_sphere rendered 10-16 % slower.
+// (SphereCaustics.TheSolverFindsEveryTracedPathFromAPoint checks that none
+// is missed). The extra points cost time, so only point lights' solves are
+// thorough.
 int connectThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections],
                          bool thorough = false);
 

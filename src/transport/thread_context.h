@@ -31,8 +31,10 @@ struct ThreadContext {
     std::vector<DensityBound> shadowBounds;
     std::vector<double> marchDepths;
     // Per light, the last ray's part inside its reach (lightReach). Held
-    // in place: as a heap vector written on every ray it made two-thread
-    // renders of fig3b_spots 1.15x slower.
+    // in place, not in a heap vector, since it is written on every ray (a
+    // heap vector slowed renders measurably: docs/benchmarks/history.md,
+    // "Beam directions weighted by the phase towards the vertex; the spot
+    // reach").
     struct ReachMemo {
         Vec3 o, d;
         float t0 = 0, t1 = 0;
