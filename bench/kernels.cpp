@@ -11,8 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "cache/direction_lobes.h"
-#include "cache/product_sampler.h"
 #include "cache/sh.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -138,78 +136,16 @@ void BM_EvalSh(benchmark::State& state) {
 }
 BENCHMARK(BM_EvalSh)->Arg(3)->Arg(8);
 
-// Product sampling of the continuation direction (cache/product_sampler.h):
-// one build per path continuation (the product of the phase function with a
-// cell's lobes), one sample from it, and plain phase sampling for
-// comparison. Inputs cycle over 256 ray directions and lobe sets, each
-// fitted to 40 photons of two lights and ambient light.
-struct ProductInputs {
-    std::vector<Vec3> rays;
-    std::vector<float> lobes;  // DirectionLobes::Floats per set
-    std::vector<PreparedLobes> prepared;
-    PhaseMixture phase;
-    ProductInputs() {
-        Rng rng(9);
-        phase.add(Color(1), 0.6f);
-        for (int i = 0; i < 256; ++i) {
-            rays.push_back(sampleUniformSphere(rng.uniform(), rng.uniform()));
-            std::vector<Vec3> wi;
-            std::vector<float> w;
-            const Vec3 a = sampleUniformSphere(rng.uniform(), rng.uniform());
-            const Vec3 b = sampleUniformSphere(rng.uniform(), rng.uniform());
-            for (int p = 0; p < 40; ++p) {
-                const Vec3 jitter = sampleUniformSphere(rng.uniform(), rng.uniform());
-                wi.push_back(p < 20 ? normalize(a + 0.2f * jitter) : p < 30 ? normalize(b + 0.1f * jitter) : jitter);
-                w.push_back(0.5f + rng.uniform());
-            }
-            lobes.resize(lobes.size() + DirectionLobes::Floats);
-            DirectionLobes::fit(wi.data(), w.data(), 40, &lobes[lobes.size() - DirectionLobes::Floats]);
-            prepared.push_back(DirectionLobes::prepare(&lobes[lobes.size() - DirectionLobes::Floats]));
-        }
-    }
-};
-
-void BM_ProductSamplerBuild(benchmark::State& state) {
-    const ProductInputs in;
-    ProductDirectionSampler s;
-    size_t i = 0;
-    for (auto _ : state) {
-        benchmark::DoNotOptimize(s.build(in.prepared[i], in.phase, in.rays[i]));
-        benchmark::ClobberMemory();
-        i = (i + 1) & 255;
-    }
-    state.SetItemsProcessed(int64_t(state.iterations()));
-}
-BENCHMARK(BM_ProductSamplerBuild);
-
-void BM_ProductSamplerSample(benchmark::State& state) {
-    const ProductInputs in;
-    ProductDirectionSampler s;
-    s.build(in.prepared[0], in.phase, in.rays[0]);
-    Rng rng(2);
-    for (auto _ : state) benchmark::DoNotOptimize(s.sample(rng.uniform(), rng.uniform(), rng.uniform()));
-    state.SetItemsProcessed(int64_t(state.iterations()));
-}
-BENCHMARK(BM_ProductSamplerSample);
-
-void BM_ProductSamplerBuildAndSample(benchmark::State& state) {
-    const ProductInputs in;
-    ProductDirectionSampler s;
-    Rng rng(2);
-    size_t i = 0;
-    for (auto _ : state) {
-        s.build(in.prepared[i], in.phase, in.rays[i]);
-        benchmark::DoNotOptimize(s.sample(rng.uniform(), rng.uniform(), rng.uniform()));
-        i = (i + 1) & 255;
-    }
-    state.SetItemsProcessed(int64_t(state.iterations()));
-}
-BENCHMARK(BM_ProductSamplerBuildAndSample);
-
-// What the continuation does today: PhaseMixture::sample around the ray.
+// Sampling a continuation direction: PhaseMixture::sample around the ray
+// (256 ray directions, g = 0.6).
 void BM_PhaseMixtureSample(benchmark::State& state) {
-    const ProductInputs in;
-    Rng rng(2);
+    struct {
+        std::vector<Vec3> rays;
+        PhaseMixture phase;
+    } in;
+    Rng rng(9);
+    in.phase.add(Color(1), 0.6f);
+    for (int i = 0; i < 256; ++i) in.rays.push_back(sampleUniformSphere(rng.uniform(), rng.uniform()));
     size_t i = 0;
     for (auto _ : state) {
         Color w(1);

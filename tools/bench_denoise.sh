@@ -34,7 +34,7 @@ for scene in "$@"; do
     if [ ! -f "$truth" ]; then
         "$BIN" render "$scene" -o "$truth" --res "$RES" --threads "$THREADS" --method "$TRUTH_METHOD" \
             --time "$(python3 -c "print($max * $TRUTH_FACTOR)")" --seed 777 --no-denoise -q --stats "$truth.json" $EXTRA \
-            --set render.adaptive=false
+            --set experiments.adaptive=false
     fi
     tn=$(field "$truth.json" "['noise_estimate']['rmse']")
     tm=$(field "$truth.json" "['noise_estimate']['mean']")

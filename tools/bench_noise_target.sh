@@ -25,7 +25,7 @@ for item in "$@"; do
     done
     for s in 11 23; do
         "$BIN" render "$scene" -o "$OUT/$name.u$s.exr" --res "$RES" --threads "$THREADS" --time "$t" --seed $s \
-            --no-denoise -q --stats "$OUT/$name.u$s.json" --set render.adaptive=false
+            --no-denoise -q --stats "$OUT/$name.u$s.json" --set experiments.adaptive=false
     done
     ra=$(rmse "$OUT/$name.a11.exr" "$OUT/$name.a23.exr"); ru=$(rmse "$OUT/$name.u11.exr" "$OUT/$name.u23.exr")
     python3 - "$name" "$target" "$t" "$ra" "$ru" \

@@ -73,10 +73,10 @@ int bakeFrame(const BakeArgs& a, std::optional<int> frame) {
     if (!a.quiet)
         std::fprintf(stderr,
                      "vdbmarch: %zu photon paths -> %llu photons (%zu direct) in %.3f s; kd-tree %.3f s; %zu cells "
-                     "(%d level(s), SH order %d%s) in %.3f s; total %.3f s -> %s\n",
+                     "(%d level(s), SH order %d) in %.3f s; total %.3f s -> %s\n",
                      r.paths, static_cast<unsigned long long>(c.info.photons), r.directPhotons, r.traceSeconds,
                      r.treeSeconds, c.cells.size(), c.levels, c.info.shOrder,
-                     c.directionLobes ? ", direction lobes" : "", r.topologySeconds + r.estimateSeconds,
+                     r.topologySeconds + r.estimateSeconds,
                      r.totalSeconds, a.output.c_str());
     return 0;
 }

@@ -120,12 +120,9 @@ LevelCounts countPhotons(const PhotonMap& map, const Vec3& origin, float h) {
 }  // namespace
 
 namespace {
-// Eq. 27 at every cell of `cache` (its topology) from `map`; with
-// cache.directionLobes also the direction lobes of the non-direct photons
-// into `lobes` (same k nearest photons): fitted afresh, or with `means` (a
-// refinement) assigned to the lobes that `means` holds.
+// Eq. 27 at every cell of `cache` (its topology) from `map`.
 std::vector<float> estimateCoefficients(const Scene& scene, const PhotonMap& map, const RadianceCache& cache,
-                                        int kNearest, std::vector<float>& lobes, const float* means = nullptr) {
+                                        int kNearest) {
     // Eq. 27 at every cell centre from its k nearest photons, with the
     // Legendre weights of the phase mixture at the centre (eq. 26: sum_i
     // w_i g_i^l where media overlap), as eq. 4 takes the phase at the point
@@ -134,16 +131,12 @@ std::vector<float> estimateCoefficients(const Scene& scene, const PhotonMap& map
     const int order = cache.info.shOrder, count = cache.coefficientCount();
     const size_t kk = size_t(std::min(kNearest, 1024));
     std::vector<float> coefficients(cache.cells.size() * size_t(count), 0.f);
-    const size_t lobeFloats = cache.directionLobes ? size_t(DirectionLobes::Floats) : 0;
-    lobes.assign(cache.cells.size() * lobeFloats, 0.f);
     tbb::enumerable_thread_specific<ThreadContext> contexts([&] { return ThreadContext(scene); });
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cache.cells.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
         ThreadContext& ctx = contexts.local();
         std::vector<uint32_t> idx(kk);
         std::vector<float> d2(kk);
         float Y[shCount(MaxShOrder)], w[MaxShOrder + 1];
-        std::vector<Vec3> lobeDir;
-        std::vector<float> lobeWeight;
         MediumPoint mp;
         for (size_t c = r.begin(); c < r.end(); ++c) {
             const Vec3 x = cache.cellCenter(cache.cells[c]);
@@ -156,15 +149,9 @@ std::vector<float> estimateCoefficients(const Scene& scene, const PhotonMap& map
                 centreScatters = mp.scatters();
                 if (centreScatters) mp.phase.legendreWeights(order, w);
             }
-            lobeDir.clear();
-            lobeWeight.clear();
             for (size_t i = 0; i + 1 < n; ++i) {  // the farthest only sets the radius
                 const Photon& p = map[idx[i]];
                 float weight = average(p.weight);
-                if (lobeFloats > 0 && !p.isDirect()) {
-                    lobeDir.push_back(-1.f * p.travelDirection());  // where a path goes to meet this light
-                    lobeWeight.push_back(weight);
-                }
                 if (order == 0) {
                     f[0] += weight;
                     continue;
@@ -179,16 +166,6 @@ std::vector<float> estimateCoefficients(const Scene& scene, const PhotonMap& map
             // Order 0: Y_00 = 1 / sqrt(4 pi) and w'_0 = 1.
             if (order == 0) f[0] *= 0.28209479f;
             for (int i = 0; i < count; ++i) f[i] *= invVolume;
-            if (lobeFloats > 0 && !lobeDir.empty()) {
-                // Photon weights over the gather volume: the statistics of
-                // separate batches average like the coefficients.
-                for (float& lw : lobeWeight) lw *= invVolume;
-                float* out = &lobes[c * lobeFloats];
-                if (means)
-                    DirectionLobes::assign(means + c * lobeFloats, lobeDir.data(), lobeWeight.data(), int(lobeDir.size()), out);
-                else
-                    DirectionLobes::fit(lobeDir.data(), lobeWeight.data(), int(lobeDir.size()), out);
-            }
         }
     });
     return coefficients;
@@ -296,9 +273,7 @@ RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_
     double topologySeconds = secondsSince(start);
 
     auto estimateStart = Clock::now();
-    cache.directionLobes = settings.directionLobes;
-    cache.coefficients = estimateCoefficients(scene, map, cache, kNearest, cache.lobes);
-    cache.prepareLobes();
+    cache.coefficients = estimateCoefficients(scene, map, cache, kNearest);
     cache.finalize();
     cache.info.buildSeconds = secondsSince(start);
     if (stats) {
@@ -311,17 +286,11 @@ RadianceCache buildRadianceCache(const Scene& scene, const PhotonMap& map, size_
 
 void refineRadianceCache(const Scene& scene, const PhotonMap& photons, size_t paths, int k, RadianceCache& cache) {
     if (cache.cells.empty() || photons.size() == 0) return;
-    std::vector<float> freshLobes;
-    const std::vector<float> fresh =
-        estimateCoefficients(scene, photons, cache, k, freshLobes, cache.lobes.empty() ? nullptr : cache.lobes.data());
+    const std::vector<float> fresh = estimateCoefficients(scene, photons, cache, k);
     // The running mean over equally weighted, independent batches.
     const double n = double(std::max<uint32_t>(1, cache.info.batches));
     const float keep = float(n / (n + 1)), add = float(1 / (n + 1));
     for (size_t i = 0; i < fresh.size(); ++i) cache.coefficients[i] = keep * cache.coefficients[i] + add * fresh[i];
-    for (size_t c = 0; c < freshLobes.size() / size_t(DirectionLobes::Floats); ++c)
-        DirectionLobes::average(&cache.lobes[c * size_t(DirectionLobes::Floats)],
-                                &freshLobes[c * size_t(DirectionLobes::Floats)], keep, add);
-    cache.prepareLobes();
     cache.info.batches = uint32_t(n) + 1;
     cache.info.photons += photons.size();
     cache.info.paths += paths;

@@ -59,8 +59,6 @@ void insertCacheKeys(openvdb::MetaMap& m, const RadianceCache& c) {
     m.insertMeta("adaptive", openvdb::BoolMetadata(info.adaptive));
     m.insertMeta("min_cell", openvdb::FloatMetadata(info.minCell));
     m.insertMeta("scene_hash", openvdb::StringMetadata(info.sceneHash));
-    m.insertMeta("direction_lobes", openvdb::BoolMetadata(c.directionLobes && c.lobes.size() >= c.cells.size() *
-                                                              size_t(DirectionLobes::Floats)));
 }
 
 // What the numbers mean, for other tools (file metadata only); the basis
@@ -158,12 +156,6 @@ std::string cacheMeanGridName(int level, int levels) {
     return levels > 1 ? str("Li_level", level) : std::string("Li");
 }
 
-std::string cacheLobeGridName(int lobe, char part, int level, int levels) {
-    std::string name = str("lobe", lobe, "_", part);
-    if (levels > 1) name += str("_level", level);
-    return name;
-}
-
 void RadianceCache::finalize() {
     mIndex = std::make_unique<Index>();
     for (int l = 0; l < levels; ++l) mIndex->levels.push_back(std::make_shared<openvdb::Int32Tree>(0));
@@ -181,17 +173,8 @@ size_t RadianceCache::cellsAtLevel(int level) const {
     return n;
 }
 
-void RadianceCache::prepareLobes() {
-    preparedLobes.clear();
-    if (!directionLobes) return;
-    preparedLobes.resize(cells.size());
-    for (size_t c = 0; c < cells.size() && (c + 1) * size_t(DirectionLobes::Floats) <= lobes.size(); ++c)
-        preparedLobes[c] = DirectionLobes::prepare(cellLobes(c));
-}
-
 size_t RadianceCache::memoryBytes() const {
-    size_t bytes = (coefficients.size() + lobes.size()) * sizeof(float) + cells.size() * sizeof(CacheCell) +
-                   preparedLobes.size() * sizeof(PreparedLobes);
+    size_t bytes = coefficients.size() * sizeof(float) + cells.size() * sizeof(CacheCell);
     if (mIndex)
         for (const auto& t : mIndex->levels) bytes += t->memUsage();
     return bytes;
@@ -265,51 +248,12 @@ void RadianceCache::save(const std::string& path) const {
         for (auto& g : perLevel[size_t(l)]) acc[size_t(l)].push_back(g->getAccessor());
         meanAcc.push_back(means[size_t(l)]->getAccessor());
     }
-    // The direction lobes (product sampling reads them back), per level and
-    // lobe: W and N as float grids, S as a vector grid in world space.
-    const bool withLobes = directionLobes && lobes.size() >= cells.size() * size_t(DirectionLobes::Floats);
-    using LobeAccessors = std::array<openvdb::FloatGrid::Accessor, 2>;  // W, N
-    std::vector<std::vector<LobeAccessors>> lobeAcc{size_t(levels)};
-    std::vector<std::vector<openvdb::Vec3SGrid::Accessor>> lobeSumAcc{size_t(levels)};
-    for (int l = 0; withLobes && l < levels; ++l) {
-        auto xform = levelTransform(origin, cellSize(l));
-        for (int j = 0; j < DirectionLobes::MaxLobes; ++j) {
-            auto meta = [&](const openvdb::GridBase::Ptr& g, const char* what) {
-                g->setTransform(xform);
-                g->insertMeta("level", openvdb::Int32Metadata(l));
-                g->insertMeta("lobe", openvdb::Int32Metadata(j));
-                g->insertMeta("cell_size", openvdb::FloatMetadata(cellSize(l)));
-                g->insertMeta("description", openvdb::StringMetadata(str(
-                    "vdbmarch radiance cache: direction lobe ", j, " of the light that is not direct (a von "
-                    "Mises-Fisher lobe fitted to the photons; product sampling reads it): ", what)));
-                grids.push_back(g);
-            };
-            auto w = openvdb::FloatGrid::create(0.f), n = openvdb::FloatGrid::create(0.f);
-            auto sum = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.f));
-            w->setName(cacheLobeGridName(j, 'W', l, levels));
-            n->setName(cacheLobeGridName(j, 'N', l, levels));
-            sum->setName(cacheLobeGridName(j, 'S', l, levels));
-            lobeAcc[size_t(l)].push_back({w->getAccessor(), n->getAccessor()});
-            lobeSumAcc[size_t(l)].push_back(sum->getAccessor());
-            meta(w, "W, the sum of the photons' weights (power over the gather volume)");
-            meta(sum, "S, the weighted sum of the directions w a path takes to meet the light (world space); "
-                       "the lobe's mean direction is S / |S|, its mean resultant length |S| / W");
-            meta(n, "N, the number of photons in the lobe");
-        }
-    }
     for (size_t i = 0; i < cells.size(); ++i) {
         const CacheCell& cell = cells[i];
         const float* f = cellCoefficients(i);
         const openvdb::Coord xyz(cell.i, cell.j, cell.k);
         for (int c = 0; c < count; ++c) acc[size_t(cell.level)][size_t(c)].setValueOn(xyz, f[c]);
         meanAcc[size_t(cell.level)].setValueOn(xyz, f[0] * Y00);
-        if (!withLobes) continue;
-        const float* s = cellLobes(i);
-        for (int j = 0; j < DirectionLobes::MaxLobes; ++j, s += DirectionLobes::LobeFloats) {
-            lobeAcc[size_t(cell.level)][size_t(j)][0].setValueOn(xyz, s[0]);
-            lobeSumAcc[size_t(cell.level)][size_t(j)].setValueOn(xyz, openvdb::Vec3s(s[1], s[2], s[3]));
-            lobeAcc[size_t(cell.level)][size_t(j)][1].setValueOn(xyz, s[4]);
-        }
     }
     AtomicFile out(path);
     try {
@@ -464,57 +408,12 @@ RadianceCache RadianceCache::load(const std::string& path) {
             }
         }
     }
-    // The direction lobes, where the bake kept them (optional grids: a
-    // cache without them loads, and product sampling follows the phase).
+    // Caches baked for product sampling (removed) also hold direction-lobe
+    // grids: nothing reads them now.
     auto lobesKey = meta->getMetadata<openvdb::BoolMetadata>("direction_lobes");
-    if (lobesKey && lobesKey->value() && !c.cells.empty()) {
-        c.directionLobes = true;
-        c.lobes.assign(c.cells.size() * size_t(DirectionLobes::Floats), 0.f);
-        auto find = [&](const std::string& name, auto tag) {
-            using GridT = typename decltype(tag)::element_type;
-            for (auto& gg : *grids)
-                if (gg && gg->getName() == name) {
-                    auto g = openvdb::gridPtrCast<GridT>(gg);
-                    if (!g) break;
-                    return g;
-                }
-            throw InputError(str(path, ": the cache says it holds direction lobes (metadata direction_lobes), but "
-                                       "grid '", name, "' is missing or not a ",
-                                 std::is_same<GridT, openvdb::FloatGrid>::value ? "float" : "vec3s", " grid"));
-        };
-        for (int l = 0; l < c.levels; ++l)
-            for (int j = 0; j < DirectionLobes::MaxLobes; ++j) {
-                const std::string nameW = cacheLobeGridName(j, 'W', l, c.levels),
-                                  nameS = cacheLobeGridName(j, 'S', l, c.levels),
-                                  nameN = cacheLobeGridName(j, 'N', l, c.levels);
-                auto w = find(nameW, openvdb::FloatGrid::Ptr()).get()->getConstAccessor();
-                auto n = find(nameN, openvdb::FloatGrid::Ptr()).get()->getConstAccessor();
-                auto sum = find(nameS, openvdb::Vec3SGrid::Ptr()).get()->getConstAccessor();
-                for (size_t i = 0; i < c.cells.size(); ++i) {
-                    const CacheCell& cell = c.cells[i];
-                    if (cell.level != l) continue;
-                    const openvdb::Coord xyz(cell.i, cell.j, cell.k);
-                    float vw, vn;
-                    openvdb::Vec3s vs;
-                    const char* lacking = !w.probeValue(xyz, vw) ? nameW.c_str()
-                                          : !sum.probeValue(xyz, vs) ? nameS.c_str()
-                                          : !n.probeValue(xyz, vn) ? nameN.c_str() : nullptr;
-                    if (lacking)
-                        throw InputError(str(path, ": cache grid '", lacking, "' lacks the cell ", xyz, " that '",
-                                             cacheGridName(0, l, c.levels), "' has"));
-                    const float v[DirectionLobes::LobeFloats] = {vw, vs.x(), vs.y(), vs.z(), vn};
-                    const char* names[DirectionLobes::LobeFloats] = {nameW.c_str(), nameS.c_str(), nameS.c_str(),
-                                                                     nameS.c_str(), nameN.c_str()};
-                    for (int k = 0; k < DirectionLobes::LobeFloats; ++k)
-                        if (!std::isfinite(v[k]) || ((k == 0 || k == 4) && v[k] < 0))
-                            throw InputError(str(path, ": cache grid '", names[k], "' holds ", v[k], " at ", xyz,
-                                                 k == 0 || k == 4 ? " (must be finite and >= 0)" : ""));
-                    float* out = &c.lobes[i * size_t(DirectionLobes::Floats) + size_t(j * DirectionLobes::LobeFloats)];
-                    for (int k = 0; k < DirectionLobes::LobeFloats; ++k) out[k] = v[k];
-                }
-            }
-        c.prepareLobes();
-    }
+    if (lobesKey && lobesKey->value())
+        warn(str(path, ": the cache's direction lobes (grids lobe<j>_W, _S, _N) are ignored: product sampling was "
+                       "removed; the SH coefficients load as usual"));
     c.finalize();
     return c;
 }

@@ -13,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "cache/direction_lobes.h"
 #include "cache/sh.h"
 #include "core/math.h"
 #include "parse/scene_desc.h"
@@ -61,19 +60,6 @@ public:
     int levels = 1;
     std::vector<CacheCell> cells;
     std::vector<float> coefficients;  // coefficientCount() per cell
-    // Optional: per cell, DirectionLobes::Floats statistics of a few von
-    // Mises-Fisher lobes fitted to the directions of the photons that are
-    // not direct, i.e. of the light a continuation path finds beside
-    // next-event estimation (direction_lobes.h). Product sampling of
-    // continuation directions reads them. Empty: none. Saved with the
-    // coefficients when present (grids lobe<j>_W, _S, _N).
-    bool directionLobes = false;
-    std::vector<float> lobes;
-    std::vector<PreparedLobes> preparedLobes;  // of `lobes`, per cell (prepareLobes())
-    const float* cellLobes(size_t cell) const { return &lobes[cell * size_t(DirectionLobes::Floats)]; }
-    // Reads `lobes` into preparedLobes, after they are estimated or refined.
-    void prepareLobes();
-
     int coefficientCount() const { return (info.shOrder + 1) * (info.shOrder + 1); }
     float cellSize(int level) const { return baseCell / float(1 << level); }
     Vec3 cellCenter(const CacheCell& c) const {
@@ -99,8 +85,7 @@ public:
     };
 
     // Writes the cache as VDB float grids (one per coefficient and level,
-    // grid class fog volume, plus the mean radiance Li per level, and the
-    // direction lobes' statistics when it has them) with file and grid
+    // grid class fog volume, plus the mean radiance Li per level) with file and grid
     // metadata (docs/scene-format.md, "The cache file"); atomically.
     void save(const std::string& path) const;
     // Reads a cache written by save(); throws InputError naming the file
@@ -125,10 +110,4 @@ private:
 std::string cacheGridName(int coefficient, int level, int levels);
 // The grid of mean radiance over directions, f_00 Y_00: "Li" or "Li_level<level>".
 std::string cacheMeanGridName(int level, int levels);
-// A direction lobe's statistics (direction_lobes.h) as grid `part` of lobe
-// `lobe` (0-3): 'W' (float, the weight), 'S' (vector, the weighted sum of
-// directions) or 'N' (float, the photon count): "lobe<lobe>_<part>", with
-// "_level<level>" in an adaptive cache.
-std::string cacheLobeGridName(int lobe, char part, int level, int levels);
-
 }  // namespace vdbmarch

@@ -8,7 +8,7 @@ namespace vdbmarch {
 namespace {
 struct Entry {
     Method method;
-    std::unique_ptr<Estimator> (*make)(const Scene&, std::shared_ptr<const Illumination>);
+    EstimatorMaker make;
 };
 // The factory table: one line per method.
 const Entry kEstimators[] = {
@@ -16,7 +16,6 @@ const Entry kEstimators[] = {
     {Method::Transmittance, makeTransmittanceMarcher},
     {Method::Guided, makeGuidedMarcher},
     {Method::Reference, makeReferenceTracer},
-    {Method::GuidedPath, makeGuidedPathTracer},
 };
 }  // namespace
 
@@ -26,11 +25,13 @@ std::vector<Method> estimatorMethods() {
     return methods;
 }
 
-std::unique_ptr<Estimator> makeEstimator(Method method, const Scene& scene, std::shared_ptr<const Illumination> illumination) {
+std::unique_ptr<Estimator> makeEstimator(Method method, const Scene& scene, std::shared_ptr<const Illumination> illumination,
+                                         std::shared_ptr<const StrategySet> strategies) {
     for (const auto& e : kEstimators)
         if (method == e.method) {
             if (!illumination) illumination = std::make_shared<Illumination>(prepareIllumination(scene, method));
-            return e.make(scene, std::move(illumination));
+            if (!strategies) strategies = StrategySet::build(scene);
+            return e.make(scene, std::move(illumination), std::move(strategies));
         }
     throw std::logic_error(str("no marcher for method ", methodName(method)));
 }

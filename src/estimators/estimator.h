@@ -1,6 +1,5 @@
 // One interface for every way of estimating the radiance along a camera ray
-// (the render's methods: the paper's three marchers, the path tracer and the
-// guided path tracer), and one factory table. Per-thread state lives in a
+// (the render's methods: the paper's three marchers and the path tracer), and one factory table. Per-thread state lives in a
 // ThreadContext.
 #pragma once
 
@@ -11,7 +10,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "parse/method.h"
-#include "transport/path_tracer.h"
+#include "paths/path_tracer.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
@@ -29,15 +28,23 @@ public:
 // (every Method: a test checks it). Method-parameterised tests run over it.
 std::vector<Method> estimatorMethods();
 // The marchers estimate L_i from `illumination` (photon map, cache); when
-// null it is prepared here from the scene (prepareIllumination).
+// null it is prepared here from the scene (prepareIllumination). Every
+// path the estimator traces iterates `strategies`, built once per render
+// (null: built here from the scene, StrategySet::build).
 std::unique_ptr<Estimator> makeEstimator(Method method, const Scene& scene,
-                                     std::shared_ptr<const Illumination> illumination = nullptr);
+                                         std::shared_ptr<const Illumination> illumination = nullptr,
+                                         std::shared_ptr<const StrategySet> strategies = nullptr);
 
 // Constructors behind the factory table.
-std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
-std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
-std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il);
-std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il);
-std::unique_ptr<Estimator> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il);
+using EstimatorMaker = std::unique_ptr<Estimator> (*)(const Scene&, std::shared_ptr<const Illumination>,
+                                                      std::shared_ptr<const StrategySet>);
+std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                              std::shared_ptr<const StrategySet> strategies);
+std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                                    std::shared_ptr<const StrategySet> strategies);
+std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                             std::shared_ptr<const StrategySet> strategies);
+std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                               std::shared_ptr<const StrategySet> strategies);
 
 }  // namespace vdbmarch

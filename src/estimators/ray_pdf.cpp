@@ -68,7 +68,7 @@ namespace {
 
 double lightsDensity(const RayPdf::Lights& lights, float t) {
     double p = 0;
-    for (const ThreadContext::LightDistance& ld : lights) p += double(ld.choice) * ld.sampler.pdf(t);
+    for (const LightDistance& ld : lights) p += double(ld.choice) * ld.sampler.pdf(t);
     return p;
 }
 

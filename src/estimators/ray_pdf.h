@@ -17,7 +17,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "transport/caustic_folds.h"
+#include "strategies/caustic_folds.h"
+#include "strategies/light_distances.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
@@ -58,7 +59,7 @@ public:
     // [0, 1 - a - b) draws from P, then a light by its odds and its sampler,
     // then the folds. False when the drawn t lies in no step (nothing
     // scatters there, or the walk ended before it): that sample adds nothing.
-    using Lights = std::vector<ThreadContext::LightDistance>;
+    using Lights = std::vector<LightDistance>;
     struct Mixture {
         double lightShare = 0;
         const Lights* lights = nullptr;

@@ -1,5 +1,5 @@
 // The unbiased reference: the volumetric path tracer of
-// transport/path_tracer.h from the camera (delta tracking against local
+// paths/path_tracer.h from the camera (delta tracking against local
 // majorants, emission at tentative collisions, next-event estimation with
 // MIS for sphere lights, the shared surface event). Media whose extinction
 // differs between RGB channels are tracked one channel per path (three
@@ -10,15 +10,11 @@
 // caustic give them at the camera path's first medium vertex (eq. 4, the
 // progressive passes' radius), as they do at the guided marcher's L_i
 // samples; the paths give all the rest.
-//
-// Guided path tracing is the same loop with the radiance cache as its guide
-// (cache_path_guide.h): free flights, and with render.product_sampling
-// directions, drawn towards where the cache says the light is.
 #include "illumination/illumination.h"
-#include "estimators/cache_path_guide.h"
 #include "estimators/estimator.h"
-#include "transport/path_tracer.h"
+#include "paths/path_tracer.h"
 #include "transport/surface_event.h"
+#include "transport/tracking.h"
 
 namespace vdbmarch {
 
@@ -38,22 +34,20 @@ private:
 
 class ReferenceTracer final : public Estimator {
 public:
-    ReferenceTracer(const Scene& s, std::shared_ptr<const Illumination> il = nullptr)
-        : mScene(s), mChromatic(hasChromaticExtinction(s)), mIllumination(std::move(il)) {
-        if (mIllumination && mIllumination->cache) mGuide = makeCachePathGuide(s, *mIllumination->cache);
-        if (mIllumination && mIllumination->causticsOnly) mCaustics = std::make_unique<CausticPhotons>(*mIllumination);
-    }
+    ReferenceTracer(const Scene& s, std::shared_ptr<const Illumination> il, std::shared_ptr<const StrategySet> strategies)
+        : mScene(s), mChromatic(hasChromaticExtinction(s)), mIllumination(std::move(il)),
+          mCaustics(mIllumination && mIllumination->causticsOnly ? std::make_unique<CausticPhotons>(*mIllumination)
+                                                                 : nullptr),
+          mPaths(s, std::move(strategies), PathOptions{false, mCaustics.get()}) {}
 
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
         ++ctx.counters.cameraRays;
         const int region = regionAtRayStart(mScene, cameraRay);
-        PathState start;
-        start.guide = mGuide.get();
-        start.firstVertexLight = mCaustics.get();
-        if (!mChromatic) return tracePath(ctx, cameraRay, region, -1, rng, start);
+        const PathState start;
+        if (!mChromatic) return mPaths.trace(ctx, cameraRay, region, -1, rng, start);
         PathRadiance out{Color(0), 0.f, Color(0), Color(0)};
         for (int c = 0; c < 3; ++c) {
-            PathRadiance p = tracePath(ctx, cameraRay, region, c, rng, start);
+            PathRadiance p = mPaths.trace(ctx, cameraRay, region, c, rng, start);
             out.L[c] = p.L[c];
             out.direct[c] = p.direct[c];
             out.emitted[c] = p.emitted[c];
@@ -65,19 +59,16 @@ public:
 private:
     const Scene& mScene;
     const bool mChromatic;
-    std::shared_ptr<const Illumination> mIllumination;  // keeps the guide's cache alive
-    std::unique_ptr<PathGuide> mGuide;
+    std::shared_ptr<const Illumination> mIllumination;  // keeps the caustic photons alive
     std::unique_ptr<InScatteredLight> mCaustics;  // null where no caustic photons are traced
+    PathTracer mPaths;
 };
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<ReferenceTracer>(scene, std::move(il));
-}
-
-std::unique_ptr<Estimator> makeGuidedPathTracer(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<ReferenceTracer>(scene, std::move(il));
+std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                               std::shared_ptr<const StrategySet> strategies) {
+    return std::make_unique<ReferenceTracer>(scene, std::move(il), std::move(strategies));
 }
 
 }  // namespace vdbmarch

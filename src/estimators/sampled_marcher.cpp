@@ -31,7 +31,8 @@
 #include <cmath>
 
 #include "estimators/segment_marcher.h"
-#include "transport/light_distance.h"
+#include "strategies/caustic_folds.h"
+#include "strategies/light_distances.h"
 #include "transport/roulette.h"
 
 namespace vdbmarch {
@@ -58,10 +59,11 @@ constexpr double FoldDistanceShare = 0.15;
 
 class SampledMarcher final : public SegmentMarcher {
 public:
-    SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il, bool guided)
-        : SegmentMarcher(scene, std::move(il)),
+    SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                   std::shared_ptr<const StrategySet> strategies, bool guided)
+        : SegmentMarcher(scene, std::move(il), std::move(strategies)),
           mGuided(guided && mIllumination->cache),
-          mLightShare(mGuided && scene.desc.render.volumeSampling != VolumeSampling::Distance ? LightDistanceShare
+          mLightShare(mGuided && scene.desc.experiments.volumeSampling != VolumeSampling::Distance ? LightDistanceShare
                                                                                               : 0.0) {
         if (mGuided) mMeanGuided = measureMeanGuided();
     }
@@ -99,8 +101,10 @@ private:
     // rather than at each: with render.li = "path" where the map holds
     // caustics alone. Not the multiply scattered light of point and spot
     // lights (pointLightsByPhotons), which varies along a ray as 1 / d^2
-    // near the light: one gather per segment doubled exp1_point's MSE at
-    // 16 s. Nor the paper's "photons", which gathers at every sample.
+    // near the light, so one gather weighted by n has far more variance
+    // (measured: docs/benchmarks/history.md, "Photons gathered within their
+    // medium region"). Nor the paper's "photons", which gathers at every
+    // sample.
     bool gathersOncePerSegment() const {
         const Illumination& il = *mIllumination;
         return il.li == LiSource::Path && il.indirect && !il.pointLightsByPhotons;
@@ -125,7 +129,7 @@ private:
         // intervals, the medium taken at one jittered point per step. The
         // media of WalkBatch steps are looked up first, in a loop of
         // independent lookups the core can overlap (a lookup's latency is
-        // about 2.4x its throughput), then the steps are taken in order.
+        // a few times its throughput), then the steps are taken in order.
         // Roulette may end the walk inside a batch: the rest were looked up
         // for nothing, never used (the pixels are those of a step-by-step
         // walk).
@@ -202,11 +206,14 @@ private:
                 // prepare their own in the same ThreadContext.
                 auto& lights = m.lightDistances;
                 lights.clear();
-                if (mLightShare > 0 && prepareLightDistances(ctx, region, ray, tEnd, -1, false).active)
-                    lights = ctx.lightDistances;
+                const StrategySet& strategies = mPaths.strategies();
+                if (mLightShare > 0 &&
+                    strategies.lightDistances().prepare(ctx, PathSegment{ray, region, -1, tEnd, false}))
+                    lights = strategies.lightDistances().prepared(ctx);
                 const double a = lights.empty() ? 0.0 : mLightShare;
                 FoldSampler& folds = m.foldDistances;
-                const bool crossesFolds = mLightShare > 0 && prepareFoldDistances(ctx, region, ray, tEnd, folds);
+                const bool crossesFolds =
+                    mLightShare > 0 && strategies.causticFolds().crossings(region, ray, tEnd, folds);
                 const RayPdf::Mixture mixture{a, &lights, crossesFolds ? FoldDistanceShare : 0.0, &folds};
                 MediumPoint ms;
                 // The caustic photons at one of the n samples, drawn uniformly
@@ -249,12 +256,14 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<SampledMarcher>(scene, std::move(il), false);
+std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                                    std::shared_ptr<const StrategySet> strategies) {
+    return std::make_unique<SampledMarcher>(scene, std::move(il), std::move(strategies), false);
 }
 
-std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<SampledMarcher>(scene, std::move(il), true);
+std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                             std::shared_ptr<const StrategySet> strategies) {
+    return std::make_unique<SampledMarcher>(scene, std::move(il), std::move(strategies), true);
 }
 
 }  // namespace vdbmarch

@@ -3,28 +3,26 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "transport/beam_directions.h"
 #include "transport/direct_light.h"
-#include "transport/glass_splitting.h"
-#include "transport/path_tracer.h"
+#include "strategies/glass_splitting.h"
+#include "paths/path_tracer.h"
 #include "transport/roulette.h"
-#include "transport/sphere_caustics.h"
 #include "transport/surface_event.h"
+#include "transport/tracking.h"
 
 namespace vdbmarch {
 
-SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination)
+SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination,
+                               std::shared_ptr<const StrategySet> strategies)
     : mScene(scene), mIllumination(std::move(illumination)), mChromatic(hasChromaticExtinction(scene)),
-      mTallyDirect(scene.desc.render.aovs.splitDirect()) {
+      mTallyDirect(scene.desc.render.aovs.splitDirect()),
+      mPaths(scene, std::move(strategies), PathOptions{mIllumination && mIllumination->pointLightsByPhotons, nullptr}) {
     // Without emissive media or refracting glass, the light arriving at a
     // sample straight from its first direction is what next-event estimation
     // samples (lights and the background).
     mLastEventByNextEvent = !hasBendingGlass(scene);
     for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
-    mProductSampling = scene.desc.render.productSampling && mIllumination->li == LiSource::Path &&
-                       mIllumination->cache && mIllumination->cache->directionLobes &&
-                       !mIllumination->cache->cells.empty();
 }
 
 PathRadiance SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
@@ -119,14 +117,12 @@ PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, Threa
             const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
             const ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
             Color Ld = beta * directLight(ctx, region, vertex, rng, {});
-            // Light through glass spheres (sphere_caustics.h): point and spot
-            // lights, which no path finds; sphere lights too where max_depth
-            // ends the path here, else the path below finds them.
-            if (sceneHasSphereCaustics(scene)) {
-                const bool last = path.diffuseBounces + 1 >= scene.desc.render.maxDepth;
-                Ld += beta * sphereCausticLight(ctx, region, vertex, rng, TransmittanceEstimator::UnbiasedMarching,
-                                                {last, true, !last});
-            }
+            // Light through specular surfaces (the connection strategies):
+            // point and spot lights, which no path finds; sphere lights too
+            // where max_depth ends the path here, else the path below finds them.
+            const bool last = path.diffuseBounces + 1 >= scene.desc.render.maxDepth;
+            for (const ConnectionStrategy* c : mPaths.strategies().connections())
+                if (c->active()) Ld += beta * c->connect(ctx, region, vertex, rng, {last, true, !last});
             L += Ld;
             if (mTallyDirect && path.diffuseBounces == 0) scratch(ctx).direct += Ld;
             // Light that reaches the surface after scattering in a medium
@@ -149,20 +145,6 @@ PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, Threa
 CacheLookup& MarcherScratch::lookup(const RadianceCache& cache) {
     if (!cacheLookup) cacheLookup = std::make_unique<CacheLookup>(cache);
     return *cacheLookup;
-}
-
-bool MarcherScratch::buildProductSampler(const RadianceCache& cache, const Vec3& x, const Vec3& rayDir,
-                                         const MediumPoint& mp, ScatterVertex& vertex) {
-    if (!productQuery) productQuery = std::make_unique<RadianceCache::Query>(cache);
-    const int64_t cell = productQuery->find(x);
-    if (cell < 0) return false;
-    // The non-direct incident radiance there: what the path can find
-    // beside next-event estimation (the direct light of delta lights is not
-    // in it: a path never finds that).
-    if (!productSampler.build(cache.preparedLobes[size_t(cell)], mp.phase, rayDir)) return false;
-    vertex.pathSampler = &productSampler;
-    vertex.pathPdf = [](const void* s, const Vec3& wi) { return static_cast<const ProductDirectionSampler*>(s)->pdf(wi); };
-    return true;
 }
 
 Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x, const Vec3& rayDir,
@@ -203,27 +185,24 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         return direct(directLight(ctx, region, vertex, rng, kLastEvent)) + photons();
     }
     static constexpr DirectLightOptions kNextEvent{TransmittanceEstimator::UnbiasedMarching, true, false};
-    // The continuation's direction: phase x cached radiance where the cache
-    // has a cell, else the phase. Next-event estimation weighs its sphere-
-    // light samples against that same density (MIS).
+    // The continuation's direction: as at the path tracer's vertices, a
+    // share of the directions towards spot and collimated beams
+    // (strategies/beam_directions.h), else the phase. Next-event estimation
+    // weighs its sphere-light samples against that same density (MIS).
     ScatterVertex nextEventVertex = vertex;
-    const ProductDirectionSampler* product = nullptr;
-    if (mProductSampling && m.buildProductSampler(*mIllumination->cache, x, rayDir, mp, nextEventVertex))
-        product = &m.productSampler;
-    // Else, as at the path tracer's vertices, a share of the directions
-    // towards spot and collimated beams (transport/beam_directions.h).
-    BeamMixture beams{&ctx, region, &nextEventVertex};
-    const bool beamDirections = !product && beams.attach(nextEventVertex, il.pointLightsByPhotons);
+    const DirectionStrategy* directions = mPaths.attachDirections(ctx, region, nextEventVertex);
     Color Li = direct(directLight(ctx, region, nextEventVertex, rng, kNextEvent));
-    // Sphere lights through glass spheres too, weighed against the
-    // continuation's own hits, and point and spot lights, whose photons
-    // then leave these caustics out (transport/sphere_caustics.h,
-    // Photon::Connected).
-    const bool caustics = sceneHasSphereCaustics(mScene);
-    if (caustics) {
-        const Color Lc = sphereCausticLight(ctx, region, nextEventVertex, rng, TransmittanceEstimator::UnbiasedMarching);
+    // Light through specular surfaces too (the connection strategies),
+    // weighed against the continuation's own hits: sphere lights, and point
+    // and spot lights, whose photons then leave these caustics out
+    // (strategies/sphere_caustics.h, Photon::Connected).
+    bool connected = false;
+    for (const ConnectionStrategy* c : mPaths.strategies().connections()) {
+        if (!c->active()) continue;
+        const Color Lc = c->connect(ctx, region, nextEventVertex, rng, {});
         Li += Lc;
         if (tallyHere) m.liDirect += Lc;
+        connected = true;
     }
     const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
@@ -231,32 +210,26 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         Color weight(1 / std::min(1.f, pathProbability));
         float pdf = 0;
         Vec3 wi;
-        if (product) {
-            const ProductSample s = product->sample(u0, u1, u2);
-            wi = s.wi;
-            weight *= s.weight;
-            pdf = s.pdf;
-        } else if (beamDirections) {
-            wi = beams.sample(rng, weight, pdf);
+        if (directions) {
+            wi = directions->sample(ctx, rng, weight, pdf);
         } else {
             wi = mp.phase.sample(rayDir, u0, u1, u2, weight, pdf);
         }
         PathState state;
-        if (beamDirections) scaleRoulette(state, nextEventVertex, wi, pdf);
+        if (directions) scaleRoulette(state, nextEventVertex, wi, pdf);
         state.depth = depth;
         state.specular = false;
         state.lastPdf = pdf;
         state.lastPoint = x;
-        state.pointLightsByPhotons = il.pointLightsByPhotons;
-        state.causticsAtLast = caustics;
+        state.connectedAtLast = connected;
         state.lastDir = wi;
         if (pdf > 0 && !mChromatic) {
-            const PathRadiance p = tracePath(ctx, Ray{x, wi}, region, -1, rng, state);
+            const PathRadiance p = mPaths.trace(ctx, Ray{x, wi}, region, -1, rng, state);
             Li += weight * p.L;
             if (tallyHere) m.liDirect += weight * p.direct;
         } else if (pdf > 0) {  // one channel, picked uniformly: 3 times its radiance
             const int c = std::min(2, int(rng.uniform() * 3));
-            const PathRadiance p = tracePath(ctx, Ray{x, wi}, region, c, rng, state);
+            const PathRadiance p = mPaths.trace(ctx, Ray{x, wi}, region, c, rng, state);
             Li[c] += 3 * weight[c] * p.L[c];
             if (tallyHere) m.liDirect[c] += 3 * weight[c] * p.direct[c];
         }

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "cache/cache_lookup.h"
-#include "cache/product_sampler.h"
 #include "illumination/illumination.h"
 #include "estimators/estimator.h"
 #include "estimators/ray_pdf.h"
@@ -30,22 +29,9 @@ struct MarcherScratch final : ThreadContextExtension {
     std::vector<float> stepH;
     MediumPoint walkMedia[WalkBatch];  // the media of the walk's next steps
     RayPdf rayPdf;
-    std::vector<ThreadContext::LightDistance> lightDistances;  // guided: the segment's equiangular samplers
+    std::vector<LightDistance> lightDistances;  // guided: the segment's equiangular samplers
     FoldSampler foldDistances;  // guided: the segment's crossings of caustic folds
     std::unique_ptr<CacheLookup> cacheLookup;  // made on first use
-    // Continuation directions by phase x cached radiance (made on first use).
-    std::unique_ptr<RadianceCache::Query> productQuery;
-    ProductDirectionSampler productSampler;
-    // Guided path tracing's prepared free flight (cache_path_guide.h): the
-    // segment, its probability of a collision, and its bins in pdfSteps,
-    // stepH and rayPdf.
-    struct FlightState {
-        Ray ray;
-        int region = 0;
-        float tEnd = 0;
-        double scatter = 0;
-        double inScattered = 0, transmittance = 1;  // FlightEstimate
-    } flight;
     // The guided marcher's probe of eq. 17's scale: march without sampling
     // and sum each segment's throughput times its histogram integral.
     bool measureOnly = false;
@@ -62,17 +48,12 @@ struct MarcherScratch final : ThreadContextExtension {
 
     // The cache lookup along rays, made on first use.
     CacheLookup& lookup(const RadianceCache& cache);
-    // Builds productSampler for a direction from x (the path arriving along
-    // rayDir, media mp) from the non-direct incident radiance of x's cell,
-    // and points `vertex`'s pathPdf at it for MIS. False: no cell or no
-    // light there (sample the phase).
-    bool buildProductSampler(const RadianceCache& cache, const Vec3& x, const Vec3& rayDir, const MediumPoint& mp,
-                             ScatterVertex& vertex);
 };
 
 class SegmentMarcher : public Estimator {
 public:
-    SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination);
+    SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination,
+                   std::shared_ptr<const StrategySet> strategies);
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
 
 private:
@@ -141,7 +122,7 @@ protected:
     const bool mChromatic;  // continuation paths track one channel
     const bool mTallyDirect;  // render.aovs asks for direct or indirect
     bool mLastEventByNextEvent = true;  // see the constructor
-    bool mProductSampling = false;      // render.product_sampling with a directional cache
+    PathTracer mPaths;  // continuation paths, with the render's strategies
 };
 
 // One step of length dx in a medium with extinction kappa: its transmittance,

@@ -64,8 +64,9 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il) {
-    return std::make_unique<UniformMarcher>(scene, std::move(il));
+std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
+                                              std::shared_ptr<const StrategySet> strategies) {
+    return std::make_unique<UniformMarcher>(scene, std::move(il), std::move(strategies));
 }
 
 }  // namespace vdbmarch

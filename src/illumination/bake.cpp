@@ -14,9 +14,6 @@ BakeResult bakeRadianceCache(const Scene& scene, const PhotonSettings& ps, const
     rq.keepAllPhotons = true;
     rq.photons = ps;
     rq.cacheSettings = cs;
-    // The lobes that guide continuation directions, for renders that will
-    // read them (render.product_sampling): saved beside the coefficients.
-    rq.cacheSettings.directionLobes = cs.directionLobes || scene.desc.render.productSampling;
     rq.renderSeed = scene.desc.render.seed;
     Illumination il = buildIllumination(scene, rq);
     BakeResult r;

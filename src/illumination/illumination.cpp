@@ -18,7 +18,7 @@ double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 }  // namespace
 
 bool methodUsesCache(Method method, const RenderSettings& render) {
-    return method == Method::Guided || method == Method::GuidedPath ||
+    return method == Method::Guided ||
            (render.li == LiSource::Cache && !isPathTracer(method));
 }
 
@@ -81,9 +81,6 @@ Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq
     if (needCache && !rq.cacheFile.empty()) {
         RadianceCache c = RadianceCache::load(rq.cacheFile);
         checkCacheMatchesScene(c, scene, rq.cacheFile, rq.force);
-        if (rq.cacheSettings.directionLobes && !c.directionLobes)
-            warn(str(rq.cacheFile, ": the cache holds no direction lobes (bake it with render.product_sampling "
-                                   "= true); continuation directions follow the phase function"));
         il.cache = std::make_unique<RadianceCache>(std::move(c));
         il.cacheLoaded = true;
         needCache = false;
@@ -210,18 +207,8 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
         requestCaustics();
         return rq;
     }
-    if (method == Method::GuidedPath) {  // the cache, as the paths' guide
-        requestCaustics();
-        rq.cache = true;
-        rq.cacheFile = options.cacheFile;
-        if (rs.productSampling) rq.cacheSettings.directionLobes = true;  // guided directions
-        return rq;
-    }
     rq.cache = methodUsesCache(method, rs);
     if (rq.cache) rq.cacheFile = options.cacheFile;
-    // Product sampling of continuation directions reads lobes fitted to the
-    // non-direct photons, beside eq. 27.
-    if (rq.cache && rs.li == LiSource::Path && rs.productSampling) rq.cacheSettings.directionLobes = true;
     // A cache file that this method and render.li leave unread is named.
     if (!rq.cache && !options.cacheFile.empty())
         warn(str(options.cacheFile, ": method ", methodName(method), " with render.li = \"", liSourceName(rs.li),

@@ -1,6 +1,6 @@
-// render.method = "auto" (the default): the method that measured best at
-// equal time for what the scene contains (BENCHMARKS.md, "The automatic
-// method"; docs/method.md has the rule and its figures).
+// render.method = "auto" (the default): the method that did best at equal
+// time for what the scene contains (docs/method.md, "The automatic method",
+// has the rule and its figures).
 #pragma once
 
 #include <string>

@@ -12,7 +12,6 @@ const MethodName kMethods[] = {
     {Method::Transmittance, "transmittance"},
     {Method::Guided, "guided"},
     {Method::Reference, "reference"},
-    {Method::GuidedPath, "guided_path"},
 };
 }  // namespace
 

@@ -8,7 +8,7 @@
 
 namespace vdbmarch {
 
-enum class Method { Uniform, Transmittance, Guided, Reference, GuidedPath };
+enum class Method { Uniform, Transmittance, Guided, Reference };
 enum class LiSource {
     // Shadow rays for direct light plus a continuation path (delta tracking,
     // next-event estimation at every vertex) for the rest; photons only for
@@ -19,9 +19,9 @@ enum class LiSource {
     Cache,    // the radiance cache alone: a fast, biased preview
 };
 
-// The path tracers (reference, guided_path): every path is traced by the
-// path loop, so render.li does not apply.
-inline bool isPathTracer(Method m) { return m == Method::Reference || m == Method::GuidedPath; }
+// The path tracer: every path is traced by the path loop, so render.li does
+// not apply.
+inline bool isPathTracer(Method m) { return m == Method::Reference; }
 
 // Every method, in the order `--method` lists them.
 const std::vector<Method>& allMethods();

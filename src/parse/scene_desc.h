@@ -83,7 +83,7 @@ const std::vector<std::string>& aovNames();
 // How free flights in media find point, spot and sphere lights (Cycles'
 // "volume sampling"): by transmittance alone (delta tracking), by distance
 // sampling towards each light (equiangular) alone, or by both weighed by
-// multiple importance sampling (transport/light_distance.h).
+// multiple importance sampling (strategies/light_distances.h).
 enum class VolumeSampling { Distance, Equiangular, Mis };
 
 struct RenderSettings {
@@ -104,37 +104,34 @@ struct RenderSettings {
     // How the marchers estimate L_i at their samples.
     LiSource li = LiSource::Path;
     int raySamples = 4;  // transmittance and guided: L_i samples per ray segment (mean for guided)
-    // li = "path" with a directional cache (guided): continuation directions
-    // from phase x cached radiance (cache/product_sampler.h), else the phase.
-    // guided_path: Russian roulette and splitting by the cache's radiance
-    // (transport/roulette.h, weightWindow); measured slower at equal time
-    // on fig3b_spots, exp1_sphere and cloud_sun (BENCHMARKS.md).
-    bool guidedRoulette = false;
-    bool productSampling = false;  // measured slower to converge on cloud_sun and exp1_sphere (BENCHMARKS.md)
     AovSet aovs;  // none by default: the EXR holds RGBA only
-    VolumeSampling volumeSampling = VolumeSampling::Mis;
-    // Path vertices connect to sphere lights through glass spheres
-    // (transport/sphere_caustics.h), weighed by MIS against the path's hits.
-    bool sphereCaustics = true;
-    // Medium vertices of the path tracer draw a share of their directions
-    // towards spot lights' beams (transport/beam_directions.h).
-    bool beamDirections = true;
-    // Camera paths follow both outcomes of their first glass event, and
-    // every other glass event counts the light its reflection sees
-    // (transport/surface_event.h, SplitDielectricEvents; mirroredLight).
-    bool glassSplitting = true;
     // Noise target (render --noise): > 0 stops the render once the
     // estimated RMSE over the image's mean is below it, sampling only the
     // blocks of pixels still above it (adaptive sampling, docs/noise.md).
     float noise = 0;
-    // Adaptive sampling in timed renders (render --time): at each noise
-    // check, blocks of pixels whose share of the time left is spent stop
-    // receiving samples, so the budget goes where it lowers the image's
-    // error most per second (docs/noise.md, "Timed renders").
-    bool adaptive = true;
     // The denoiser (docs/denoise.md): Preview denoises the PNG only; On also
     // the EXR's RGBA (the noisy beauty kept as a layer).
     enum class Denoise { Off, Preview, On } denoise = Denoise::Preview;
+};
+
+// Switches of default-on sampling strategies, for A/B measurements rather
+// than shots (scene key "experiments"; docs/scene-format.md).
+struct ExperimentSettings {
+    VolumeSampling volumeSampling = VolumeSampling::Mis;
+    // Path vertices connect to sphere lights through glass spheres
+    // (strategies/sphere_caustics.h), weighed by MIS against the path's hits.
+    bool sphereCaustics = true;
+    // Medium vertices draw a share of their directions towards spot and
+    // collimated beams (strategies/beam_directions.h).
+    bool beamDirections = true;
+    // Camera paths follow both outcomes of their first glass event, and
+    // every other glass event counts the light its reflection sees
+    // (strategies/glass_splitting.h).
+    bool glassSplitting = true;
+    // Adaptive sampling in timed renders (render --time): blocks of pixels
+    // whose share of the time left is spent stop receiving samples
+    // (docs/noise.md, "Timed renders").
+    bool adaptive = true;
 };
 
 // The volume photon map (scene key "photons").
@@ -158,9 +155,6 @@ struct CacheSettings {
     float quality = 1;      // the paper's a
     bool adaptive = false;  // octree-like subdivision where photons are dense
     float minCell = 0;      // smallest adaptive cell, world units (0: automatic)
-    // Not a scene key: set by the renderer when product sampling reads the
-    // directions of the cache's non-direct photons (RadianceCache::lobes).
-    bool directionLobes = false;
 };
 
 // An environment map (scene key "environment"): a lat-long EXR of the
@@ -184,6 +178,7 @@ struct SceneDesc {
     RenderSettings render;
     PhotonSettings photons;
     CacheSettings cache;
+    ExperimentSettings experiments;
     std::string jsonText;  // the effective document (compact JSON), recorded in outputs
     // The frame the scene was loaded for (--frames): its file paths have the
     // frame token replaced (parse/frames.h); none for a single render.

@@ -310,9 +310,14 @@ AovSet parseAovs(const JsonReader& r) {
 }
 
 RenderSettings parseRender(const JsonReader& r) {
+    // Keys of earlier versions: switches that moved to "experiments", and
+    // options that measured not to pay and were removed.
+    for (const char* k : {"volume_sampling", "sphere_caustics", "beam_directions", "glass_splitting", "adaptive"})
+        if (r.has(k)) r.fail(k, str("moved to experiments.", k, " (a switch for A/B measurements; docs/scene-format.md)"));
+    for (const char* k : {"majorant", "product_sampling", "guided_roulette"})
+        if (r.has(k)) r.fail(k, "was removed (it did not pay at equal time; docs/benchmarks/history.md): delete the key");
     r.allowOnly({"method", "spp", "step", "shadow_step", "max_depth", "seed", "threads", "max_surface_bounces",
-                 "pixel_jitter", "exposure", "majorant", "li", "ray_samples", "product_sampling", "guided_roulette", "aovs",
-                 "volume_sampling", "sphere_caustics", "beam_directions", "glass_splitting", "noise", "adaptive", "denoise"});
+                 "pixel_jitter", "exposure", "li", "ray_samples", "aovs", "noise", "denoise"});
     RenderSettings s;
     {
         std::vector<std::string> names = {"auto"};
@@ -335,29 +340,29 @@ RenderSettings parseRender(const JsonReader& r) {
     s.maxSurfaceBounces = r.integer("max_surface_bounces", s.maxSurfaceBounces, 0, 1000);
     s.pixelJitter = r.boolean("pixel_jitter", s.pixelJitter);
     s.exposure = float(r.numberIn("exposure", 0, -64, 64));
-    // One majorant per VDB block, always: "local" is still accepted (scenes of
-    // 0.3 and before); "global" was a benchmark baseline, removed.
-    r.choice("majorant", "local", {"local"});
     parseLiSource(r.choice("li", liSourceName(s.li), {"path", "photons", "cache"}), s.li);
-    s.productSampling = r.boolean("product_sampling", s.productSampling);
-    s.guidedRoulette = r.boolean("guided_roulette", s.guidedRoulette);
     s.raySamples = r.integer("ray_samples", s.raySamples, 1, 4096);
     if (r.has("aovs")) s.aovs = parseAovs(r);
-    {
-        const std::string v = r.choice("volume_sampling", "mis", {"mis", "distance", "equiangular"});
-        s.volumeSampling = v == "distance" ? VolumeSampling::Distance
-                           : v == "equiangular" ? VolumeSampling::Equiangular : VolumeSampling::Mis;
-    }
-    s.sphereCaustics = r.boolean("sphere_caustics", s.sphereCaustics);
-    s.beamDirections = r.boolean("beam_directions", s.beamDirections);
-    s.glassSplitting = r.boolean("glass_splitting", s.glassSplitting);
     if (r.has("noise")) s.noise = float(r.numberIn("noise", 0, 1e-4, 10));
-    s.adaptive = r.boolean("adaptive", s.adaptive);
     {
         const std::string v = r.choice("denoise", "preview", {"preview", "on", "off"});
         s.denoise = v == "on" ? RenderSettings::Denoise::On
                     : v == "off" ? RenderSettings::Denoise::Off : RenderSettings::Denoise::Preview;
     }
+    return s;
+}
+
+ExperimentSettings parseExperiments(const JsonReader& r) {
+    r.allowOnly({"volume_sampling", "sphere_caustics", "beam_directions", "glass_splitting", "adaptive"});
+    ExperimentSettings s;
+    const std::string v = r.choice("volume_sampling", "mis", {"mis", "distance", "equiangular"});
+    s.volumeSampling = v == "distance"      ? VolumeSampling::Distance
+                       : v == "equiangular" ? VolumeSampling::Equiangular
+                                            : VolumeSampling::Mis;
+    s.sphereCaustics = r.boolean("sphere_caustics", s.sphereCaustics);
+    s.beamDirections = r.boolean("beam_directions", s.beamDirections);
+    s.glassSplitting = r.boolean("glass_splitting", s.glassSplitting);
+    s.adaptive = r.boolean("adaptive", s.adaptive);
     return s;
 }
 
@@ -439,6 +444,7 @@ std::string sceneHash(const SceneDesc& desc) {
     j.erase("photons");
     j.erase("cache");
     j.erase("render");
+    j.erase("experiments");
     j["max_depth"] = desc.render.maxDepth;
     char buf[17];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(fnv1a64(j.dump())));
@@ -473,7 +479,8 @@ SceneDesc parseSceneJson(const Json& input, const std::string& file, std::option
     scene.baseDir = slash == std::string::npos ? "." : file.substr(0, slash == 0 ? 1 : slash);
     scene.jsonText = doc.dump();
     JsonReader root(doc, file, "");
-    root.allowOnly({"camera", "lights", "media", "surfaces", "background", "environment", "render", "photons", "cache"});
+    root.allowOnly({"camera", "lights", "media", "surfaces", "background", "environment", "render", "photons", "cache",
+                    "experiments"});
     if (root.has("camera")) scene.camera = parseCamera(root.object("camera"));
     auto listOf = [&](const char* key) -> const Json& {
         const Json& v = root.raw(key);
@@ -533,6 +540,7 @@ SceneDesc parseSceneJson(const Json& input, const std::string& file, std::option
     if (root.has("render")) scene.render = parseRender(root.object("render"));
     if (root.has("photons")) scene.photons = parsePhotons(root.object("photons"));
     if (root.has("cache")) scene.cache = parseCache(root.object("cache"));
+    if (root.has("experiments")) scene.experiments = parseExperiments(root.object("experiments"));
     if (scene.render.methodAuto) scene.render.method = chooseMethod(scene, scene.render.methodReason);
     return scene;
 }

@@ -18,8 +18,7 @@ public:
     // medium region (Photon::region): a gather near a glass surface must not
     // take photons from the other side, whose weights Phi / sigma_t belong
     // to another medium (a fog photon next to milk of 200x its extinction
-    // counts 200x a milk photon, and one such photon in a milk estimate was
-    // most of exp2_collimated's squared error).
+    // counts 200x a milk photon).
     enum class Search { All, ByRegion };
 
     // Takes the photons (their weights already carry 1 / paths); builds the

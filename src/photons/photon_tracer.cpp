@@ -11,9 +11,8 @@
 #include "core/memory.h"
 #include "core/sampling.h"
 #include "transport/media_point.h"
-#include "transport/path_tracer.h"
 #include "transport/roulette.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
 
@@ -216,8 +215,9 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
     auto start = std::chrono::steady_clock::now();
     PhotonSet set;
     if (paths == 0 || !sceneScatters(scene)) return set;
-    // About one stored photon per path (0.7 in a cloud, 2 in glass scenes:
-    // BENCHMARKS.md), 44 bytes each with its kd-tree share.
+    // About one stored photon per path, 44 bytes each with its kd-tree share
+    // (measured: docs/benchmarks/history.md, "Photon map and radiance cache
+    // build").
     checkMemory(uint64_t(paths) * 44, str("photons.count = ", paths, " (about 44 bytes per stored photon)"));
     const PhotonTarget target = photonTarget(scene);
     if (target.bounds.empty()) return set;

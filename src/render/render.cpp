@@ -324,7 +324,7 @@ std::vector<double> denoiserGains(const PixelSums& frame, const std::vector<floa
     return gain;
 }
 
-// Adaptive sampling of a timed render (render.adaptive, docs/noise.md) at a
+// Adaptive sampling of a timed render (experiments.adaptive, docs/noise.md) at a
 // check after n samples, with `secondsLeft` of camera time left (summed over
 // the threads). Each block has s_b and t_b, its pixels' measured seconds
 // per sample, and where the render is denoised K_b (`gains`, empty: 1), the
@@ -577,8 +577,8 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     open.pass = -1;
     AovSums aovSums(aovs, pixels);
     // Adaptive sampling: towards the noise target (render.noise), or in a
-    // timed render by each block's noise and measured time (render.adaptive).
-    const bool timedAdaptive = timed && rs.adaptive && rs.noise <= 0;
+    // timed render by each block's noise and measured time (experiments.adaptive).
+    const bool timedAdaptive = timed && scene.desc.experiments.adaptive && rs.noise <= 0;
     const bool adaptive = rs.noise > 0 || timedAdaptive;
     if (adaptive) sums.convergedAt.assign(pixels, 0);
     PixelTimes times;
@@ -598,9 +598,12 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
     // comparison charges the guided marcher for its cache.
     std::shared_ptr<Illumination> illumination;
     std::unique_ptr<Estimator> marcher;
+    // The sampling strategies and their tables, once per render.
+    const std::shared_ptr<const StrategySet> strategies =
+        options.strategies ? options.strategies : StrategySet::build(scene);
     arena.execute([&] {
         illumination = std::make_shared<Illumination>(buildIllumination(scene, request));
-        marcher = makeEstimator(rs.method, scene, illumination);
+        marcher = makeEstimator(rs.method, scene, illumination, strategies);
     });
     const double firstIlluminationSeconds = illumination->stats.seconds;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
@@ -695,7 +698,7 @@ RenderResult renderImage(const Scene& scene, const RenderOptions& options) {
             if (pass != illumination->photonPass) {
                 arena.execute([&] {
                     if (photonPasses.advance(scene, pass, *illumination))
-                        marcher = makeEstimator(rs.method, scene, illumination);
+                        marcher = makeEstimator(rs.method, scene, illumination, strategies);
                 });
             }
             const int end = std::min(s1, photonPasses.progressive() ? photonPasses.firstSampleOf(pass + 1) : s1);

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -14,6 +15,7 @@
 #include "image/image.h"
 #include "illumination/illumination.h"
 #include "scene/scene.h"
+#include "strategies/strategy_set.h"
 
 namespace vdbmarch {
 
@@ -71,6 +73,9 @@ struct RenderOptions {
     // Also sum PathRadiance::emitted per pixel in halves (E, oddE), which the
     // denoiser takes apart from the scattered light (docs/denoise.md).
     bool keepEmitted = false;
+    // The sampling strategies every path iterates (null: the scene's
+    // defaults, StrategySet::build); tests plug their own in here.
+    std::shared_ptr<const StrategySet> strategies;
 };
 
 // An RGB sum in double: thousands of samples add up without the float

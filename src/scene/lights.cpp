@@ -98,6 +98,15 @@ bool Light::sample(const Vec3& x, float u1, float u2, LightSample& s) const {
     return false;
 }
 
+float Light::directionPdf(const Vec3& x) const {
+    if (mDesc.type != LightDesc::Type::Sphere) return 0;
+    const Vec3 to = mDesc.position - x;
+    const float d2 = lengthSquared(to), r2 = mDesc.radius * mDesc.radius;
+    if (d2 <= r2 * 1.0001f) return 0;
+    const float sin2 = r2 / d2, cosMax = sin2 < 1e-6f ? 1 - 0.5f * sin2 : safeSqrt(1 - sin2);
+    return uniformConePdf(cosMax);
+}
+
 bool Light::reachInterval(const Ray& r, float& t0, float& t1) const {
     t0 = 0;
     t1 = Infinity;

@@ -37,6 +37,12 @@ public:
     // False when the light cannot illuminate x (outside a spot cone, beside a
     // collimated quad, inside a sphere light).
     bool sample(const Vec3& x, float u1, float u2, LightSample& s) const;
+    // The solid-angle density with which sample() at x draws a direction
+    // that hits the light: uniform over the cone a sphere light subtends,
+    // so the same for every such direction. 0 for delta lights and where
+    // sample() cannot draw (inside a sphere light). The path loops weigh a
+    // path's own light hits against next-event estimation by it (MIS).
+    float directionPdf(const Vec3& x) const;
     bool isDelta() const { return mDesc.type != LightDesc::Type::Sphere; }
     bool isSphere() const { return mDesc.type == LightDesc::Type::Sphere; }
     // A point or spot light: its irradiance grows as 1/d^2 close to it, so

@@ -57,7 +57,7 @@ bool mayBeInside(const Scene& scene, const Vec3& p, const std::vector<int>& arou
 }
 
 // The spheres of refracting glass, uniformly scaled, that next-event
-// estimation sees light through (transport/sphere_caustics.h), empty or
+// estimation sees light through (strategies/sphere_caustics.h), empty or
 // holding a medium.
 void findGlassSpheres(Scene& scene) {
     for (size_t i = 0; i < scene.desc.surfaces.size(); ++i) {
@@ -108,13 +108,13 @@ void warnOfMissedCaustics(const Scene& scene) {
         warn(str(desc.file, ": the caustics that a delta light (point, spot, directional or collimated_quad) "
                             "casts through refracting glass onto diffuse surfaces are missing from a "
                             "unidirectional path tracer (in media the caustic photons give them), except "
-                            "through glass spheres with render.sphere_caustics; use sphere lights where the "
+                            "through glass spheres with experiments.sphere_caustics; use sphere lights where the "
                             "reference must converge"));
 }
 
 // Scene::deltaLightCaustics.
 bool connectsDeltaLightCaustics(const Scene& scene) {
-    if (!scene.desc.render.sphereCaustics) return false;
+    if (!scene.desc.experiments.sphereCaustics) return false;
     for (size_t i = 0; i < scene.surfaces.size(); ++i) {
         const SurfaceInfo& info = scene.surfaces[i];
         const bool bends = info.material.type == MaterialDesc::Type::Dielectric && !crossedByShadowRays(info.material);

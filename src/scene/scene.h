@@ -33,7 +33,7 @@ struct SurfaceInfo {
 };
 
 // A smooth glass sphere that next-event estimation sees light through
-// (transport/sphere_caustics.h): a sphere surface of refracting dielectric,
+// (strategies/sphere_caustics.h): a sphere surface of refracting dielectric,
 // uniformly scaled, with no medium inside.
 struct GlassSphere {
     Vec3 center;
@@ -48,7 +48,7 @@ struct GlassSphere {
 // The fold of the caustic that a glass sphere focuses from a point-like or
 // parallel light outside it (the pattern of two refractions): where
 // neighbouring exit rays meet, so two of the connections to the light merge
-// and their spreading goes to 0 (transport/caustic_folds.h). The light's
+// and their spreading goes to 0 (strategies/caustic_folds.h). The light's
 // rays through the ball are symmetric about the axis through the light (or
 // along a parallel light's direction) and the centre, so the fold is a
 // surface of revolution: the envelope of the exit rays in one plane through
@@ -92,7 +92,7 @@ public:
     std::vector<GlassSphere> glassSpheres;
     // The caustics of delta lights through the scene's refracting glass are
     // found by sphere caustic connections (sphere_caustics.h), so no photon
-    // needs to carry them: render.sphere_caustics, every refracting surface
+    // needs to carry them: experiments.sphere_caustics, every refracting surface
     // one of glassSpheres, at least one delta light, every point or spot off
     // the spheres' surfaces (inside one or outside all), every collimated
     // quad outside them (directional lights always are).

@@ -19,8 +19,8 @@ struct ScatterVertex {
     const PhaseMixture* phase = nullptr;
     Vec3 n;  // surface only
     Color albedo{0, 0, 0};
-    // The path's own direction density when it does not sample f (product
-    // sampling, a later layer): MIS must weigh light samples against it.
+    // The path's own direction density when it does not sample f alone (a
+    // beam mixture, beam_directions.h): MIS weighs light samples against it.
     float (*pathPdf)(const void* sampler, const Vec3& wi) = nullptr;
     const void* pathSampler = nullptr;
 
@@ -69,21 +69,16 @@ struct DirectLightOptions {
 
 // Shadow-ray roulette by the phase value (DirectLightOptions::phaseRoulette).
 // In a forward-scattering medium most light samples fall outside the lobe
-// (for g = 0.8 and random directions, 85 % have a phase value below the
-// isotropic one, and they carry about a third of the light), and their
-// shadow rays cost as much as the lobe's. A light sample whose phase value f
-// is below the level PhaseRouletteShare x the phase's mean value
-// (PhaseMixture::meanPhaseValue) casts its shadow ray with probability
-// f / level and then counts as if f were the level: unbiased, bounded, and
-// its survivors are no larger than the lobe's own samples. Levels at or
-// below the isotropic value (g up to about 0.5) roulette nothing, and so
-// do regions without a VDB medium: there a shadow ray costs an intersection
-// and an exp, not a march through a grid, and the roulette saved no time
-// (fig3b_spots, a g = 0.8 haze: 8 % fewer shadow rays, 1.04-1.12x the
-// MSE x time).
-// Measured on cloud_sun (g = 0.8, BENCHMARKS.md): levels 1, 2, 4, 8 and 16
-// times the isotropic value gave 0.70-0.87, 0.66-0.72, 0.54-0.70,
-// 0.47-0.54 and 0.58-0.68 of the MSE x time without roulette.
+// and carry little light, yet their shadow rays cost as much as the lobe's.
+// A light sample whose phase value f is below the level PhaseRouletteShare x
+// the phase's mean value (PhaseMixture::meanPhaseValue) casts its shadow ray
+// with probability f / level and then counts as if f were the level:
+// unbiased, bounded, and its survivors are no larger than the lobe's own
+// samples. Levels at or below the isotropic value (g up to about 0.5)
+// roulette nothing, and so do regions without a VDB medium, where a shadow
+// ray is only an intersection and an exp. The share was tuned by
+// measurement: docs/benchmarks/history.md, "Shadow-ray roulette by the phase
+// value; a cheaper block walk".
 constexpr float PhaseRouletteShare = 0.5f;
 
 Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng, const DirectLightOptions& options);

@@ -1,7 +1,6 @@
 #include "transport/first_event.h"
 
 #include "transport/media_point.h"
-#include "transport/path_tracer.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
 

@@ -52,37 +52,4 @@ inline bool russianRoulette(float& w, Rng& rng, float threshold) {
     return on;
 }
 
-// Guided Russian roulette and splitting (Vorba & Krivanek 2016, "Adjoint-
-// Driven Russian Roulette and Splitting"): r is a path's expected
-// contribution (throughput x the guide's radiance at its vertex) over the
-// pixel's estimate. Inside the weight window [WindowLow, WindowHigh] the
-// path goes on; below it, it survives with probability max(r, WindowMinSurvival)
-// (a wrong guide costs at most 1 / WindowMinSurvival in variance); above
-// it, it splits into min(round(r), splitLimit) paths of weight 1 / n.
-constexpr float WindowLow = 1.f / 3.f, WindowHigh = 5.f / 3.f;  // a window of width 5 about 1
-constexpr float WindowMinSurvival = 0.1f;
-// A path and the copies split from it are at most this many paths.
-constexpr int MaxSplitPaths = 8;
-
-struct WindowDecision {
-    int paths = 1;       // 0: the path ends; > 1: it splits
-    float weight = 1;    // factor on each path's throughput
-};
-
-// splitLimit: how many paths this one may still become (>= 1).
-inline WindowDecision weightWindow(float r, float u, int splitLimit) {
-    WindowDecision d;
-    if (!(r >= 0)) return d;  // NaN: the path goes on as it is
-    if (!(r < WindowHigh)) {
-        if (!(r <= float(MaxSplitPaths))) r = float(MaxSplitPaths);  // also +inf and NaN
-        d.paths = std::max(1, std::min(int(r + 0.5f), splitLimit));
-        d.weight = 1.f / float(d.paths);
-    } else if (r < WindowLow) {
-        const float q = std::max(r, WindowMinSurvival);
-        if (u >= q) d.paths = 0;
-        d.weight = 1.f / q;
-    }
-    return d;
-}
-
 }  // namespace vdbmarch

@@ -48,9 +48,10 @@ DielectricEvents dielectricEvents(const Scene& scene, const SurfaceHit& hit, con
 // Camera paths follow both outcomes of their first this many glass events
 // before any scattering event. A small light mirrored in glass is a
 // highlight a thousand times the surroundings' brightness that a Fresnel
-// choice of a few percent finds in a few of a pixel's samples: the noise of
-// that count was most of fig4_caustic_sphere's error (BENCHMARKS.md,
-// "Glass highlights").
+// choice of a few percent finds in only a few of a pixel's samples;
+// following both outcomes removes the noise of that count
+// (docs/benchmarks/history.md, "Glass highlights: both outcomes of a camera
+// path's first glass event").
 constexpr int SplitDielectricEvents = 1;
 
 // Offset origin for a ray leaving a surface at p in direction d.

@@ -1,7 +1,8 @@
 // Per-thread state of every path loop: one medium query per medium (VDB
 // accessors), scratch vectors reused across rays, and the render counters.
-// An estimator that needs scratch of its own keeps it in `extension`, made
-// on first use, so this layer knows nothing of the estimators above it.
+// The sampling strategies and the estimators above keep their scratch in
+// `extensions`, made on first use, so this layer knows nothing of them.
+// Tables made once per render live with the strategies, not here.
 #pragma once
 
 #include <memory>
@@ -29,24 +30,11 @@ struct ThreadContext {
     // not sampled yet, and the optical-depth estimates.
     std::vector<DensityBound> shadowBounds;
     std::vector<double> marchDepths;
-    // Distance sampling towards lights along the current path segment
-    // (light_distance.h), and next-event weights per light.
-    struct LightDistance {
-        int light;
-        EquiangularSampler sampler;
-        float choice = 1;  // probability that the segment samples this light
-    };
-    std::vector<LightDistance> lightDistances;
-    std::vector<float> lightWeights;
-    // Made on first use by light_distance.cpp: per region, the bounds of
-    // its scattering media, and per (region, light) whether the light can
-    // ever get distance samples there.
-    std::vector<BBox> scatterBounds;
-    std::vector<char> lightDistanceCandidate;
-    // Per light, the last ray's part inside its reach (lightReach): a beam
-    // direction's density and the next segment's distance samplers ask for
-    // the same ray. Held in place: as a heap vector written on every ray it
-    // made two-thread renders of fig3b_spots 1.15x slower.
+    // Per light, the last ray's part inside its reach (lightReach). Held
+    // in place, not in a heap vector, since it is written on every ray (a
+    // heap vector slowed renders measurably: docs/benchmarks/history.md,
+    // "Beam directions weighted by the phase towards the vertex; the spot
+    // reach").
     struct ReachMemo {
         Vec3 o, d;
         float t0 = 0, t1 = 0;
@@ -54,51 +42,38 @@ struct ThreadContext {
     };
     static constexpr int ReachMemoLights = 4;  // the first lights only
     ReachMemo reachMemo[ReachMemoLights];
-    // Made on first use by beam_directions.cpp: per region, the beams of
-    // spot lights (cones) and collimated quads (prisms) its medium vertices
-    // draw directions towards.
-    struct Beam {
-        int light;
-        Vec3 apex, axis, e1, e2;  // a prism's "apex" is its quad's centre
-        float tanCone = 0;
-        float s0, s1;     // the axial range sampled (the region's media)
-        float power = 1;  // scattered power per unit length of beam
-        // A collimated quad's prism: the quad's edges u, v and their axial
-        // parts, the dual vectors that give a point's quad coordinates
-        // (|a|, |b| <= 1/2 inside) along the beam, and the cross-section's
-        // area perpendicular to the axis.
-        bool prism = false;
-        Vec3 u, v, dualA, dualB;
-        float uAxial = 0, vAxial = 0, area = 0;
-    };
-    struct BeamRegion {
-        std::vector<Beam> beams;
-        // The integral of the media's phase function over the scattering
-        // angle, G(theta) = int_0^theta p(cos a) da, at BeamAngleSteps + 1
-        // angles over [0, pi] (beam_directions.cpp, shared by all threads).
-        const std::vector<float>* angleIntegral = nullptr;
-    };
-    std::vector<BeamRegion> beamRegions;
-    // Made on first use by caustic_folds.cpp: the folds of the caustics of
-    // point-like and parallel lights through glass spheres (shared by all
-    // threads), with a bounding sphere and the half-width of the density
-    // drawn around a crossing.
-    struct FoldSurface {
-        int sphere = -1, light = -1;
-        std::shared_ptr<const CausticFold> fold;
-        Vec3 boundCenter;
-        float boundRadius = 0, halfWidth = 0;
-    };
-    std::vector<FoldSurface> foldSurfaces;
-    bool foldSurfacesMade = false;
     RenderCounters counters;
-    std::unique_ptr<ThreadContextExtension> extension;
+    // Scratch of the layers above, one slot each, made on first use: slot 0
+    // is the estimator's, the sampling strategies number theirs from 1
+    // (strategies/strategy_set.h).
+    std::vector<std::unique_ptr<ThreadContextExtension>> extensions;
 
-    // The extension as type T, made on first use.
-    template <typename T, typename... Args>
-    T& extensionAs(Args&&... args) {
-        if (!extension) extension = std::make_unique<T>(std::forward<Args>(args)...);
-        return static_cast<T&>(*extension);
+    template <typename T>
+    T& extensionAt(size_t slot) {
+        if (extensions.size() <= slot) extensions.resize(slot + 1);
+        if (!extensions[slot]) extensions[slot] = std::make_unique<T>();
+        return static_cast<T&>(*extensions[slot]);
+    }
+    // The estimator's scratch (slot 0).
+    template <typename T>
+    T& extensionAs() { return extensionAt<T>(0); }
+
+    // Light::reachInterval of scene light `light` for `ray`, remembered for
+    // the last ray asked (bit-identical rays only): a beam direction's
+    // density and the next segment's distance samplers ask for the same ray.
+    bool lightReach(int light, const Ray& ray, float& t0, float& t1) {
+        if (light >= ReachMemoLights) return scene.lights[size_t(light)].reachInterval(ray, t0, t1);
+        ReachMemo& m = reachMemo[light];
+        if (!(m.valid && m.o.x == ray.o.x && m.o.y == ray.o.y && m.o.z == ray.o.z && m.d.x == ray.d.x &&
+              m.d.y == ray.d.y && m.d.z == ray.d.z)) {
+            m.reaches = scene.lights[size_t(light)].reachInterval(ray, m.t0, m.t1);
+            m.o = ray.o;
+            m.d = ray.d;
+            m.valid = true;
+        }
+        t0 = m.t0;
+        t1 = m.t1;
+        return m.reaches;
     }
 };
 

@@ -49,4 +49,12 @@ void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, i
     }
 }
 
+bool hasChromaticExtinction(const Scene& scene) {
+    for (const auto& m : scene.media) {
+        const Color k = m->sigma_a + m->sigma_s;
+        if (k.x != k.y || k.y != k.z) return true;
+    }
+    return false;
+}
+
 }  // namespace vdbmarch

@@ -19,6 +19,14 @@ namespace vdbmarch {
 // Extinction used for tracking: channel c, or (grey media, channel < 0) channel 0.
 inline float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[channel < 0 ? 0 : channel]; }
 
+// Tracking probabilities of the channel, or for grey extinction the channel
+// average (sigma_a + sigma_s sums to sigma_t either way).
+inline float trackedOrAverage(const Color& c, int channel) { return channel < 0 ? average(c) : c[channel]; }
+
+// True when some medium's extinction differs between channels: paths then
+// track one channel each, which keeps every estimator unbiased.
+bool hasChromaticExtinction(const Scene& scene);
+
 // A medium's extinction majorant from its density bound and coefficient.
 // evalMedia clamps each coefficient to MaxCoefficient, so the extinction
 // never exceeds twice that: the bound keeps huge inputs (density 1e30 x

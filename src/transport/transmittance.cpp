@@ -116,14 +116,15 @@ Color ratioTracking(ThreadContext& ctx, int region, const Ray& r, float tEnd, Rn
 // walk early. The series of core/power_series.h turns order + 1 such
 // estimates into an unbiased transmittance whose noise is close to stepped
 // marching's exp(-tau); most shadow rays need one estimate (order 0 with
-// probability SeriesPZero). Constants measured (0.5-4 per stratum, 0.75 and
-// 0.9: BENCHMARKS.md).
+// probability SeriesPZero). The constants were tuned by measurement:
+// docs/benchmarks/history.md, "Shadow rays: unbiased ray marching".
 constexpr double MarchedDepthPerStratum = 1.0;
 constexpr double MarchedPoolDepth = 4.0;
 constexpr double SeriesPZero = 0.75;
 // Deep shadow rays are ended by roulette once less than this share of the
-// light is left (measured on the Disney cloud: 0.2 cost 0.81x the MSE x time
-// of 1e-3, the camera paths' threshold; BENCHMARKS.md).
+// light is left, far above the camera paths' RouletteThreshold; tuned by
+// measurement: docs/benchmarks/history.md, "The block walk and shadow-ray
+// roulette; the default render against the yardstick".
 constexpr double ShadowRouletteThreshold = 0.2;
 constexpr int MaxStrataPerPool = 4096;  // absurd majorants: wider strata, still unbiased
 

@@ -320,8 +320,8 @@ PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activ
     // shared constant blocks).
     uint64_t leaves = gridBytes > interior ? (gridBytes - interior) / leafBytes : 0;
     if (leaves == 0) leaves = (activeVoxels + LeafT::SIZE - 1) / LeafT::SIZE;
-    // Blocks with their own values per leaf, measured on the sample assets
-    // and the upsampled clouds (docs/memory.md): 1.03-1.17; in all 1.06-1.27.
+    // Blocks with their own values per leaf, and blocks in all: ratios
+    // measured on the sample assets and the upsampled clouds (docs/memory.md).
     const uint64_t kept = leaves * 110 / 100, all = leaves * 125 / 100;
     const uint64_t perBlock = Size * sizeof(float) + sizeof(uint32_t) + 2 * sizeof(float);
     const uint64_t lists = sizeof(openvdb::Coord) * (all + leaves);  // block origins, leaves in x order
@@ -339,7 +339,7 @@ PaddedBlocks::Footprint PaddedBlocks::predict(uint64_t gridBytes, uint64_t activ
 
 // A chunk is mapped from the system directly, 2 MB aligned, with transparent
 // huge pages asked for: the kernel then maps 2 MB per page fault, not 4 kB
-// (in 4 kB pages the faults of a 1 GB build took 1.7 s). Not from malloc,
+// (in 4 kB pages, faulting in a large build took seconds). Not from malloc,
 // whose heap would place chunks by its own thresholds among the freed
 // leaves; pages of the last chunk that no block reaches are never resident.
 constexpr size_t HugePage = size_t(2) << 20;

@@ -41,7 +41,7 @@ struct PaddedBlocks {
     // smallest value of the padded block: every trilinear value inside the
     // cells lies between them, so they are a local majorant and a
     // residual-tracking control. Tables per id, not per block: the constant
-    // blocks (a third of the 16x cloud's) add no entry.
+    // blocks add no entry.
     std::vector<uint32_t> tightBox;
     std::vector<float> blockMax, blockMin;
     // Bounding box of the dilated topology's active voxels (index space).

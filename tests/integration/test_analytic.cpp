@@ -161,9 +161,8 @@ TEST_P(Determinism, ImageIsIdenticalForAnyThreadCount) {
     EXPECT_EQ(0, std::memcmp(a.image.rgba.data(), c.image.rgba.data(), a.image.rgba.size() * sizeof(float)));
     EXPECT_EQ(a.counters.marchSamples, c.counters.marchSamples);
     // Photons are re-traced when a photon map or a cache is used (never by
-    // the reference tracer; guided path tracing refines its guide).
-    const bool photonsUsed = method == Method::GuidedPath || (method != Method::Reference &&
-                                                             (li == LiSource::Photons || method == Method::Guided));
+    // the reference tracer).
+    const bool photonsUsed = method != Method::Reference && (li == LiSource::Photons || method == Method::Guided);
     EXPECT_EQ(a.photonPasses, photonsUsed ? 4 : 1);
     double sum = 0;
     for (float v : a.image.rgba) sum += v;
@@ -208,7 +207,7 @@ TEST_P(TimeBudget, PassesGiveTheSameImageAsTheSameSampleCount) {
     // count only, not on where the budget ran out.
     // Adaptive sampling off: its stops depend on the measured time.
     SceneDesc d = loadSceneFile(scenePath, {"camera.resolution=[24,18]", "render.max_depth=2", "photons.count=5000",
-                                            "photons.spp_per_pass=2", "render.adaptive=false", liOverride(li),
+                                            "photons.spp_per_pass=2", "experiments.adaptive=false", liOverride(li),
                                             methodOverride(method)});
     auto scene = buildScene(d);
     RenderOptions timed;
@@ -264,7 +263,7 @@ const ExrLayer* samplesLayer(const RenderResult& r) {
     return nullptr;
 }
 
-// Adaptive sampling of a timed render (render.adaptive, docs/noise.md): the
+// Adaptive sampling of a timed render (experiments.adaptive, docs/noise.md): the
 // background's blocks, of zero noise, stop at the first check (16 samples)
 // and the slab's sample on; blocks stop whole; the samples layer says so.
 TEST(TimedAdaptive, BlocksOfNoNoiseStopAtTheFirstCheck) {
@@ -351,9 +350,9 @@ TEST(TimedAdaptive, BlocksTheDenoiserCleansGetFewerSamples) {
     EXPECT_LT(first, 0.5 * second) << "first column " << first / 128 << " spp, second " << second / 128;
 }
 
-// render.adaptive = false: every pixel gets the same samples.
+// experiments.adaptive = false: every pixel gets the same samples.
 TEST(TimedAdaptive, OffSamplesEvenly) {
-    auto scene = buildScene(halfSlabScene({"render.adaptive=false"}));
+    auto scene = buildScene(halfSlabScene({"experiments.adaptive=false"}));
     RenderOptions timed;
     timed.timeBudget = 0.5;
     const RenderResult r = renderImage(*scene, timed);

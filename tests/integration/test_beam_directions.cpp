@@ -1,5 +1,5 @@
 // Directions towards spot and collimated beams in the path tracer
-// (transport/beam_directions.h): renders with render.beam_directions on must
+// (strategies/beam_directions.h): renders with experiments.beam_directions on must
 // agree with renders whose vertices sample f alone (off), region by region
 // within 4 standard errors of the paired difference: the paper's spot scene
 // (haze and a diffuse floor), a spot inside two overlapping hazes of
@@ -18,7 +18,7 @@ namespace {
 using namespace test;
 
 Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool beams, int seed = 3) {
-    return renderSampleToggled(sample, overrides, "render.beam_directions", beams, seed);
+    return renderSampleToggled(sample, overrides, "experiments.beam_directions", beams, seed);
 }
 
 // The scene's own max_depth 8: roulette (from depth 3) is part of what the

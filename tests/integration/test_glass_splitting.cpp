@@ -1,4 +1,4 @@
-// Glass splitting (render.glass_splitting; transport/surface_event.h,
+// Glass splitting (experiments.glass_splitting; transport/surface_event.h,
 // SplitDielectricEvents; transport/transmittance.h, mirroredLight): camera
 // paths follow both outcomes of their first glass event, weighted by their
 // Fresnel chances, and every other glass event counts the light its
@@ -23,7 +23,7 @@ namespace {
 using namespace test;
 
 Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool split, int seed = 3) {
-    return renderSampleToggled(sample, overrides, "render.glass_splitting", split, seed);
+    return renderSampleToggled(sample, overrides, "experiments.glass_splitting", split, seed);
 }
 
 const std::vector<std::string> CausticScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",

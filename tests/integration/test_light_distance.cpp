@@ -1,5 +1,5 @@
-// Distance sampling towards lights (transport/light_distance.h) in the path
-// tracer: every render.volume_sampling mode against numerical quadrature of
+// Distance sampling towards lights (strategies/light_distances.h) in the path
+// tracer: every experiments.volume_sampling mode against numerical quadrature of
 // single scattering from a point and a spot light inside a homogeneous box,
 // and the three modes against one another on a heterogeneous VDB cloud with
 // multiple scattering, glass, a sphere light and an environment map; and the
@@ -75,8 +75,8 @@ TEST(LightDistance, SingleScatteringFromPointAndSpotMatchesQuadrature) {
         for (const char* mode : VolumeSamplingModes) {
             auto scene = sceneFromJson("{" + camera + "," + lights + "," + media + str(R"(,
                 "photons": {"count": 20000}, "render": {"method": ")", method,
-                                                                      R"(", "max_depth": 1, "spp": 64, "seed": 5,
-                "volume_sampling": ")", mode, "\"}}"));
+                                                                      R"(", "max_depth": 1, "spp": 64, "seed": 5},
+                "experiments": {"volume_sampling": ")", mode, "\"}}"));
             const Image img = renderImage(*scene).image;
             for (int part = 0; part < 3; ++part) {
                 SampleStats st;
@@ -99,7 +99,7 @@ TEST(LightDistance, ModesAgreeOnAHeterogeneousCloudWithGlassAndSky) {
     common.insert(common.end(), {"render.method=\"reference\"", "render.spp=256"});
     auto render = [&](const std::string& mode) {
         std::vector<std::string> o = common;
-        o.push_back("render.volume_sampling=\"" + mode + "\"");
+        o.push_back("experiments.volume_sampling=\"" + mode + "\"");
         return renderImage(*buildScene(loadSceneFile(samplePath("cloud_sky.json"), o))).image;
     };
     const Image base = render("distance");
@@ -128,7 +128,7 @@ SampleStats squaredDifferences(const Image& a, const Image& b) {
 // bound; measured 0.95-1.01x, standard error 0.13-0.15), three standard
 // errors included, because a quarter of the positions follow the
 // equiangular density over the beam. The paper's pdf alone
-// (render.volume_sampling = "distance") measured 2.9-4.0x, and must stay
+// (experiments.volume_sampling = "distance") measured 2.9-4.0x, and must stay
 // above 1x: the scene shows what the share is for.
 TEST(LightDistance, GuidedMarcherWithAWrongCacheKeepsItsNoise) {
     const std::string json = R"({"camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0],
@@ -137,8 +137,8 @@ TEST(LightDistance, GuidedMarcherWithAWrongCacheKeepsItsNoise) {
                     "falloff_deg": 3, "intensity": 20}],
         "media": [{"type": "homogeneous", "sigma_a": 0.05, "sigma_s": 0.3, "g": 0.3,
                    "bounds": {"min": [-3, -1.2, -1], "max": [3, 1.2, 1]}}],
-        "photons": {"count": 40000}, "render": {"method": "@METHOD@", "max_depth": 1, "spp": 32, "seed": @SEED@,
-        "volume_sampling": "@MODE@"}})";
+        "photons": {"count": 40000}, "render": {"method": "@METHOD@", "max_depth": 1, "spp": 32, "seed": @SEED@},
+        "experiments": {"volume_sampling": "@MODE@"}})";
     auto scene = [&](const std::string& method, const std::string& mode, int seed) {
         return sceneFromJson(subst(json, {{"METHOD", method}, {"MODE", mode}, {"SEED", str(seed)}}));
     };

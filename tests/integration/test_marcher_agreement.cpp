@@ -86,8 +86,8 @@ void checkAgreement(const std::string& name, const std::string& sceneFile, const
         o.insert(o.end(), run.extra.begin(), run.extra.end());
         const RenderResult r = render(sceneFile, o, run.method, run.spp);
         // No allowance where no photon enters the estimate: the methods
-        // without a cache trace none (guided and guided_path build their guide
-        // from photons, which shapes only their pdfs).
+        // without a cache trace none (guided builds its cache from photons,
+        // which shapes only its pdf).
         if (photonBias == 0 && (run.method == Method::Uniform || run.method == Method::Transmittance)) {
             EXPECT_EQ(r.photons, 0u) << methodName(run.method);
         }
@@ -105,8 +105,8 @@ void checkAgreement(const std::string& name, const std::string& sceneFile, const
 // and their kNN estimate is within a few percent where the photon density is
 // smooth (PhotonMapAccuracy tests, 4 SE at k = 100). Measured
 // (VDBMARCH_VERBOSE=1, 2026-12-03) on the cloud under the spot: -1.4%, -0.7%,
-// -0.8% and -2.4% of the image mean for uniform, transmittance, guided and
-// guided_path (2.0, 1.2, 1.4 and 1.4 SE); 3% bounds that bias with margin.
+// -0.8% of the image mean for uniform, transmittance and guided (2.0, 1.2
+// and 1.4 SE); 3% bounds that bias with margin.
 // The sphere light traces no photons (no delta light, no caustic): every
 // marcher is unbiased there but for the uniform marcher's step (O((kappa
 // dx)^2) at step 0.01), so that scene gets no allowance beyond 4 SE.

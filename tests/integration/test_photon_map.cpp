@@ -16,7 +16,7 @@
 #include "photons/photon_map.h"
 #include "photons/photon_tracer.h"
 #include "illumination/illumination.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
 #include "support/support.h"
 
 namespace vdbmarch {
@@ -308,7 +308,7 @@ TEST(PhotonTracing, ConnectedPhotonsAreTheCausticsTheConnectionsFind) {
 
     const IlluminationRequest rq = illuminationRequest(*scene, Method::Guided);
     EXPECT_TRUE(rq.exceptConnected);
-    const auto off = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {"render.sphere_caustics=false"}));
+    const auto off = buildScene(loadSceneFile(test::samplePath("scenes/fig4_caustic.json"), {"experiments.sphere_caustics=false"}));
     EXPECT_FALSE(off->deltaLightCaustics);
     EXPECT_FALSE(illuminationRequest(*off, Method::Guided).exceptConnected);
     for (const Photon& p : tracePhotons(*off, 20000, 5).photons) EXPECT_FALSE(p.isConnected());

@@ -35,13 +35,6 @@ std::string spotScene(float g, bool adaptive) {
 
 BakeResult bake(const Scene& s) { return bakeRadianceCache(s, s.desc.photons, s.desc.cache); }
 
-// The spot scene baked with the direction lobes of product sampling.
-BakeResult bakeWithLobes(const Scene& s) {
-    CacheSettings cs = s.desc.cache;
-    cs.directionLobes = true;
-    return bakeRadianceCache(s, s.desc.photons, cs);
-}
-
 TEST(RadianceCache, CoefficientsAreEq27OfTheNearestPhotons) {
     auto scene = sceneFromJson(spotScene(0.7f, false));
     BakeResult r = bake(*scene);
@@ -336,93 +329,6 @@ TEST(RadianceCacheFile, RoundTripKeepsEveryCellAndCoefficient) {
 
 void expectInputError(const std::string& path, const std::string& fragment) {
     expectErrorContaining<InputError>([&] { RadianceCache::load(path); }, {path, fragment});
-}
-
-// The direction lobes (product sampling's guide) are saved with the
-// coefficients and read back to the last bit, per cell of every level.
-TEST(RadianceCacheFile, RoundTripKeepsTheDirectionLobes) {
-    for (bool adaptive : {false, true}) {
-        SCOPED_TRACE(adaptive ? "adaptive" : "uniform");
-        auto scene = sceneFromJson(spotScene(0.7f, adaptive));
-        BakeResult r = bakeWithLobes(*scene);
-        ASSERT_TRUE(r.cache.directionLobes);
-        ASSERT_EQ(r.cache.lobes.size(), r.cache.cells.size() * size_t(DirectionLobes::Floats));
-        size_t withLight = 0;
-        for (size_t i = 0; i < r.cache.cells.size(); ++i) withLight += r.cache.cellLobes(i)[0] > 0;
-        ASSERT_GT(withLight, r.cache.cells.size() / 4);  // a real fit, not zeros
-        TempDir dir("cache");
-        const std::string path = dir / "lobes.vdb";
-        r.cache.save(path);
-        RadianceCache back = RadianceCache::load(path);
-        ASSERT_TRUE(back.directionLobes);
-        ASSERT_EQ(back.lobes.size(), r.cache.lobes.size());
-        ASSERT_EQ(back.preparedLobes.size(), back.cells.size());
-        RadianceCache::Query q(back);
-        for (size_t i = 0; i < r.cache.cells.size(); ++i) {
-            const int64_t j = q.find(r.cache.cellCenter(r.cache.cells[i]));
-            ASSERT_GE(j, 0);
-            for (int k = 0; k < DirectionLobes::Floats; ++k)
-                ASSERT_EQ(back.cellLobes(size_t(j))[k], r.cache.cellLobes(i)[k]) << "cell " << i << " float " << k;
-            const PreparedLobes &a = back.preparedLobes[size_t(j)], &b = r.cache.preparedLobes[i];
-            ASSERT_EQ(a.count, b.count);
-            for (int k = 0; k < a.count; ++k) {
-                EXPECT_EQ(a.kappa[k], b.kappa[k]);
-                EXPECT_EQ(a.logWeightNorm[k], b.logWeightNorm[k]);
-            }
-        }
-        // A cache baked without them loads without them.
-        BakeResult plain = bake(*scene);
-        const std::string plainPath = dir / "plain.vdb";
-        plain.cache.save(plainPath);
-        RadianceCache noLobes = RadianceCache::load(plainPath);
-        EXPECT_FALSE(noLobes.directionLobes);
-        EXPECT_TRUE(noLobes.lobes.empty());
-    }
-}
-
-// A lobe grid that is missing, lacks a cell, or holds a bad value is named.
-TEST(RadianceCacheFile, DamagedLobeGridsAreNamed) {
-    auto scene = sceneFromJson(spotScene(0.7f, false));
-    BakeResult r = bakeWithLobes(*scene);
-    TempDir dir("cache");
-    const std::string good = dir / "good.vdb";
-    r.cache.save(good);
-    openvdb::io::File file(good);
-    file.open();
-    openvdb::GridPtrVecPtr grids = file.getGrids();
-    openvdb::MetaMap::Ptr meta = file.getMetadata();
-    file.close();
-    auto rewrite = [&](const std::string& name, auto&& change) {
-        openvdb::GridPtrVec out;
-        for (auto& g : *grids) {
-            openvdb::GridBase::Ptr copy = g->deepCopyGrid();
-            if (copy->getName() == "lobe2_W" && !change(copy)) continue;  // dropped
-            out.push_back(copy);
-        }
-        const std::string path = dir / name;
-        openvdb::io::File(path).write(out, *meta);
-        return path;
-    };
-    setWarningsQuiet(true);  // rewritten files have no checksum trailer
-    expectInputError(rewrite("missing.vdb", [](openvdb::GridBase::Ptr&) { return false; }), "'lobe2_W' is missing");
-    const CacheCell cell = r.cache.cells[r.cache.cells.size() / 2];
-    const openvdb::Coord xyz(cell.i, cell.j, cell.k);
-    expectInputError(rewrite("hole.vdb", [&](openvdb::GridBase::Ptr& g) {
-                         openvdb::gridPtrCast<openvdb::FloatGrid>(g)->tree().setValueOff(xyz);
-                         return true;
-                     }),
-                     "'lobe2_W' lacks the cell");
-    expectInputError(rewrite("nan.vdb", [&](openvdb::GridBase::Ptr& g) {
-                         openvdb::gridPtrCast<openvdb::FloatGrid>(g)->tree().setValue(xyz, std::nanf(""));
-                         return true;
-                     }),
-                     "'lobe2_W' holds nan");
-    expectInputError(rewrite("negative.vdb", [&](openvdb::GridBase::Ptr& g) {
-                         openvdb::gridPtrCast<openvdb::FloatGrid>(g)->tree().setValue(xyz, -1.f);
-                         return true;
-                     }),
-                     "'lobe2_W' holds -1");
-    setWarningsQuiet(false);
 }
 
 TEST(RadianceCacheFile, RefusesAnotherScene) {

@@ -1,5 +1,5 @@
-// Sphere caustic connections in the path tracer (transport/sphere_caustics.h):
-// renders with render.sphere_caustics on must agree with renders where the
+// Sphere caustic connections in the path tracer (strategies/sphere_caustics.h):
+// renders with experiments.sphere_caustics on must agree with renders where the
 // paths alone find the light through the glass (off), region by region
 // within 4 standard errors of the paired difference: the paper's caustic
 // scene (fog and a diffuse floor under a glass ball, a sphere light above),
@@ -28,7 +28,7 @@
 
 #include "illumination/illumination.h"
 #include "photons/photon_tracer.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
 #include "support/support.h"
 
 namespace vdbmarch {
@@ -37,7 +37,7 @@ namespace {
 using namespace test;
 
 Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool caustics, int seed = 3) {
-    return renderSampleToggled(sample, overrides, "render.sphere_caustics", caustics, seed);
+    return renderSampleToggled(sample, overrides, "experiments.sphere_caustics", caustics, seed);
 }
 
 // The path tracer without the connections and without the caustic photons
@@ -197,8 +197,8 @@ TEST(SphereCaustics, ThePathTracerWarnsWhereItMissesCaustics) {
         return warningCount() - before;
     };
     EXPECT_EQ(warnings({}), 0);  // the point light's caustics are connected
-    EXPECT_EQ(warnings({"render.sphere_caustics=false"}), 1);
-    EXPECT_NE(lastWarning().find("render.sphere_caustics"), std::string::npos) << lastWarning();
+    EXPECT_EQ(warnings({"experiments.sphere_caustics=false"}), 1);
+    EXPECT_NE(lastWarning().find("experiments.sphere_caustics"), std::string::npos) << lastWarning();
     EXPECT_EQ(warnings({R"(surfaces.0.transform={"scale": [0.45, 0.3, 0.45], "translate": [0, 0.75, 0]})"}), 1);
 }
 
@@ -207,7 +207,7 @@ TEST(SphereCaustics, DeltaLightCausticsOnlyWhereConnectionsFindThemAll) {
         return buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), o))->deltaLightCaustics;
     };
     EXPECT_TRUE(flag({}));
-    EXPECT_FALSE(flag({"render.sphere_caustics=false"}));
+    EXPECT_FALSE(flag({"experiments.sphere_caustics=false"}));
     // Directional lights connect along their direction; a collimated quad
     // must lie outside the ball.
     EXPECT_TRUE(flag({R"(lights=[{"type": "point", "position": [0, 2.6, 0], "intensity": 1},
@@ -359,7 +359,7 @@ TEST(SphereCausticRenders, ACollimatedBeamHoldingTheBallAddsTheSunsCaustic) {
 TEST(SphereCausticRenders, TheSunsCausticAgreesWithThePhotonsOfTheMarcher) {
     // Single scattering in fog under the ball and in a globe of milk: the
     // light the connections add to the path tracer (on - off) against what
-    // the guided marcher's caustic photons add (render.sphere_caustics off;
+    // the guided marcher's caustic photons add (experiments.sphere_caustics off;
     // both take the rest from shadow rays), in the image's mean: photons
     // blur the caustic but keep its light. Within 6 % of it: the blur
     // across the image's edges and the noise of both (measured: 1.7 %).

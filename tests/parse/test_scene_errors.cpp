@@ -179,6 +179,31 @@ TEST_F(BadInput, ProgressivePhotonSettingsOutOfRange) {
     EXPECT_CONTAINS(msg, "photons.progressive");
 }
 
+// Render keys of earlier versions: the A/B switches that moved to
+// "experiments" say where they went; removed options say they were removed.
+TEST_F(BadInput, MovedAndRemovedRenderKeysSaySo) {
+    std::string msg = errorOf<InputError>([&] { parseSceneText(R"({"render": {"beam_directions": false}})", "old.json"); });
+    EXPECT_CONTAINS(msg, "old.json");
+    EXPECT_CONTAINS(msg, "render.beam_directions");
+    EXPECT_CONTAINS(msg, "experiments.beam_directions");
+    for (const char* key : {"product_sampling", "guided_roulette", "majorant"}) {
+        msg = errorOf<InputError>([&] { parseSceneText(homogeneousScene(), "old.json", {str("render.", key, "=true")}); });
+        EXPECT_CONTAINS(msg, str("render.", key));
+        EXPECT_CONTAINS(msg, "removed");
+    }
+    msg = errorOf<InputError>([&] { parseSceneText(R"({"render": {"method": "guided_path"}})", "old.json"); });
+    EXPECT_CONTAINS(msg, "render.method");
+    EXPECT_CONTAINS(msg, "guided_path");
+    const SceneDesc d = parseSceneText(homogeneousScene(), "new.json",
+                                       {"experiments.beam_directions=false", "experiments.volume_sampling=\"distance\""});
+    EXPECT_FALSE(d.experiments.beamDirections);
+    EXPECT_TRUE(d.experiments.sphereCaustics);
+    EXPECT_EQ(d.experiments.volumeSampling, VolumeSampling::Distance);
+    msg = errorOf<InputError>([&] { parseSceneText(R"({"experiments": {"volume_sampling": "fast"}})", "x.json"); });
+    EXPECT_CONTAINS(msg, "experiments.volume_sampling");
+    EXPECT_CONTAINS(msg, "fast");
+}
+
 TEST_F(BadInput, HenyeyGreensteinGOfOne) {
     std::string msg = errorOf<InputError>([&] { parseSceneText(homogeneousScene(", \"g\": 1"), "g.json"); });
     EXPECT_CONTAINS(msg, "g.json");

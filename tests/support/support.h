@@ -219,7 +219,7 @@ void expectPairedAgreement(const Image& a, const Image& b, const std::string& wh
 double pairMse(const Image& a, const Image& b);
 
 // A sample scene rendered with `overrides`, the boolean render setting
-// `toggle` (e.g. "render.sphere_caustics") set to `on`, and render.seed.
+// `toggle` (e.g. "experiments.sphere_caustics") set to `on`, and render.seed.
 Image renderSampleToggled(const std::string& sample, std::vector<std::string> overrides, const std::string& toggle,
                           bool on, int seed);
 

@@ -1,12 +1,10 @@
-#include "transport/beam_directions.h"
+#include "strategies/beam_directions.h"
 
 #include <cmath>
-#include <map>
-#include <memory>
-#include <mutex>
 
 #include "core/sampling.h"
-#include "transport/light_distance.h"
+#include "strategies/light_distances.h"
+#include "transport/phase.h"
 #include "volume/medium.h"
 
 namespace vdbmarch {
@@ -36,29 +34,20 @@ float regionPhaseG(const Scene& scene, int region) {
 }
 
 // G(theta) = int_0^theta p_HG(cos a, g) da at BeamAngleSteps + 1 angles,
-// by Simpson's rule on 8 sub-steps per step. Made once per g in the process
-// (thread contexts are made per block of pixels and sweep; the table took
-// a tenth of a timed render's time when each made its own).
-const std::vector<float>* phaseAngleIntegral(float g) {
-    static std::mutex mutex;
-    static std::map<float, std::unique_ptr<const std::vector<float>>> tables;
-    const std::lock_guard<std::mutex> lock(mutex);
-    std::unique_ptr<const std::vector<float>>& table = tables[g];
-    if (!table) {
-        std::vector<float> G(BeamAngleSteps + 1, 0.f);
-        const double step = PiD / BeamAngleSteps, h = step / 8;
-        auto p = [&](double a) { return double(hgPhase(float(std::cos(a)), g)); };
-        double sum = 0;
-        for (int k = 0; k < BeamAngleSteps; ++k) {
-            for (int j = 0; j < 8; ++j) {
-                const double a = k * step + j * h;
-                sum += h / 6 * (p(a) + 4 * p(a + 0.5 * h) + p(a + h));
-            }
-            G[size_t(k + 1)] = float(sum);
+// by Simpson's rule on 8 sub-steps per step.
+std::vector<float> phaseAngleIntegral(float g) {
+    std::vector<float> G(BeamAngleSteps + 1, 0.f);
+    const double step = PiD / BeamAngleSteps, h = step / 8;
+    auto p = [&](double a) { return double(hgPhase(float(std::cos(a)), g)); };
+    double sum = 0;
+    for (int k = 0; k < BeamAngleSteps; ++k) {
+        for (int j = 0; j < 8; ++j) {
+            const double a = k * step + j * h;
+            sum += h / 6 * (p(a) + 4 * p(a + 0.5 * h) + p(a + h));
         }
-        table = std::make_unique<const std::vector<float>>(std::move(G));
+        G[size_t(k + 1)] = float(sum);
     }
-    return table.get();
+    return G;
 }
 
 // The axial range [s0, s1] of `hull` along a beam from `origin` (its
@@ -76,11 +65,11 @@ void axialRange(const BBox& hull, const Vec3& origin, const Vec3& axis, float& s
 
 // A spot's cone, where its distance sampling may pay in the region
 // (light_distance.h's candidates).
-bool spotBeam(ThreadContext& ctx, const BBox& hull, size_t i, int region, ThreadContext::Beam& b) {
-    const Scene& scene = ctx.scene;
+bool spotBeam(const Scene& scene, const LightDistances& distances, const BBox& hull, size_t i, int region,
+              BeamDirections::Beam& b) {
     const Light& light = scene.lights[i];
-    if (light.desc().type != LightDesc::Type::Spot || !regionHasLightDistances(ctx, region, false) ||
-        !ctx.lightDistanceCandidate[size_t(region) * scene.lights.size() + i])
+    if (light.desc().type != LightDesc::Type::Spot || !distances.regionHasCandidates(region, false) ||
+        !distances.candidate(region, int(i)))
         return false;
     b.light = int(i);
     b.apex = light.desc().position;
@@ -105,7 +94,7 @@ bool spotBeam(ThreadContext& ctx, const BBox& hull, size_t i, int region, Thread
 // the (possibly tilted) quad, over the region's hull. Its cross-section
 // perpendicular to the axis is the quad seen along the beam, of constant
 // area, so the power per unit length is the irradiance times that area.
-bool prismBeam(const Scene& scene, const BBox& hull, size_t i, int region, ThreadContext::Beam& b) {
+bool prismBeam(const Scene& scene, const BBox& hull, size_t i, int region, BeamDirections::Beam& b) {
     const LightDesc& d = scene.lights[i].desc();
     if (d.type != LightDesc::Type::CollimatedQuad || !openToRegion(scene, d.center, region)) return false;
     b.light = int(i);
@@ -131,35 +120,6 @@ bool prismBeam(const Scene& scene, const BBox& hull, size_t i, int region, Threa
     b.s1 = s1;
     b.power = std::max(average(d.irradiance), 0.f) * b.area;
     return b.s1 > b.s0 && b.power > 0;
-}
-
-// The beams of every region, made on a thread's first use: per region a
-// list of spots and collimated quads with their axial range over the
-// region's scattering media.
-void buildBeams(ThreadContext& ctx) {
-    const Scene& scene = ctx.scene;
-    const size_t nLights = scene.lights.size();
-    ctx.beamRegions.assign(scene.regions.size(), {});
-    for (size_t r = 0; r < scene.regions.size(); ++r) {
-        const BBox& hull = scatterBounds(ctx, int(r));
-        if (!hull.isFinite() || hull.empty()) continue;
-        // Thin media only: in a dense one a path sent towards a beam meets
-        // a collision long before it, and the directions it did not take
-        // by f cost more than they bring (a spot in the sample cloud: 16x
-        // the pair MSE per sample).
-        double depth = 0;
-        for (int mi : scene.regions[r].media) {
-            const Medium& m = *scene.media[size_t(mi)];
-            depth += double(maxComponent(m.sigma_a + m.sigma_s)) * double(m.maxDensity());
-        }
-        if (!(depth * double(length(hull.extent())) <= MaxBeamRegionDepth)) continue;
-        ThreadContext::BeamRegion& out = ctx.beamRegions[r];
-        for (size_t i = 0; i < nLights; ++i) {
-            ThreadContext::Beam b;  // each maker first checks the light's type
-            if (spotBeam(ctx, hull, i, int(r), b) || prismBeam(scene, hull, i, int(r), b)) out.beams.push_back(b);
-        }
-        if (!out.beams.empty()) out.angleIntegral = phaseAngleIntegral(regionPhaseG(scene, int(r)));
-    }
 }
 
 // The integral of t^2 / s(t)^2 over [ta, tb], s(t) = sx + c t > 0 there:
@@ -210,15 +170,15 @@ inline double angleAt(double y, double x) {
 static_assert(BeamMixture::Sight::Edges == BeamBins + 1, "a sight holds G at every bin edge");
 
 struct BeamView {
-    const ThreadContext::Beam* beam = nullptr;
+    const BeamDirections::Beam* beam = nullptr;
     const std::vector<float>* G = nullptr;
     BeamMixture::Sight sight;
     // The vertex's stored sight, whose edge integrals are kept (or null).
     BeamMixture::Sight* stored = nullptr;
 
-    BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, BeamMixture::Sight& s)
+    BeamView(const BeamDirections::Beam& b, const std::vector<float>& table, BeamMixture::Sight& s)
         : beam(&b), G(&table), sight(s), stored(&s) {}
-    BeamView(const ThreadContext::Beam& b, const std::vector<float>& table, const Vec3& x) : beam(&b), G(&table) {
+    BeamView(const BeamDirections::Beam& b, const std::vector<float>& table, const Vec3& x) : beam(&b), G(&table) {
         const Vec3 v = x - b.apex;
         sight.sx = double(dot(v, b.axis));
         // Off the axis by at least the disc's radius at the range's start
@@ -252,7 +212,7 @@ struct BeamView {
 // Beam k as the mixture's vertex sees it: from the sights made once per
 // vertex (the first MaxSights beams), or made now.
 BeamView viewOf(const BeamMixture& m, size_t k) {
-    const ThreadContext::BeamRegion& r = m.ctx->beamRegions[size_t(m.region)];
+    const BeamDirections::Region& r = m.beams->region(m.region);
     if (m.mBeamWeight < 0) {
         double total = 0;
         for (size_t j = 0; j < r.beams.size(); ++j) {
@@ -274,7 +234,7 @@ BeamView viewOf(const BeamMixture& m, size_t k) {
 
 // A prism's chord: the part of x + t wi whose quad coordinates lie in
 // [-1/2, 1/2] (two slabs).
-bool prismChord(const ThreadContext::Beam& b, const Vec3& x, const Vec3& wi, float& t0, float& t1) {
+bool prismChord(const BeamDirections::Beam& b, const Vec3& x, const Vec3& wi, float& t0, float& t1) {
     double lo = 0, hi = double(Infinity);
     for (const Vec3* dual : {&b.dualA, &b.dualB}) {
         const double a = double(dot(x - b.apex, *dual)), da = double(dot(wi, *dual));
@@ -298,9 +258,9 @@ bool prismChord(const ThreadContext::Beam& b, const Vec3& x, const Vec3& wi, flo
 // integrated along the ray over the beam's part in the bin, with the
 // Jacobian t^2.
 double beamPdf(ThreadContext& ctx, const BeamView& view, const Vec3& x, const Vec3& wi) {
-    const ThreadContext::Beam& b = *view.beam;
+    const BeamDirections::Beam& b = *view.beam;
     float t0, t1;
-    if (b.prism ? !prismChord(b, x, wi, t0, t1) : !lightReach(ctx, b.light, Ray{x, wi}, t0, t1)) return 0;
+    if (b.prism ? !prismChord(b, x, wi, t0, t1) : !ctx.lightReach(b.light, Ray{x, wi}, t0, t1)) return 0;
     const double sx = double(dot(x - b.apex, b.axis)), c = double(dot(wi, b.axis));
     double ta = t0, tb = t1;
     if (std::fabs(c) < 1e-12) {
@@ -358,14 +318,55 @@ double beamsPdf(ThreadContext& ctx, size_t n, ViewAt&& viewAt, const Vec3& x, co
 
 }  // namespace
 
-bool regionHasBeamDirections(ThreadContext& ctx, int region, bool skipPointLights) {
-    if (!ctx.scene.desc.render.beamDirections || skipPointLights) return false;
-    if (ctx.beamRegions.empty()) buildBeams(ctx);
-    return !ctx.beamRegions[size_t(region)].beams.empty();
+BeamDirections::BeamDirections(const Scene& scene, const LightDistances& distances, size_t slot)
+    : mRegions(scene.regions.size()), mSlot(slot) {
+    if (!scene.desc.experiments.beamDirections) return;
+    const size_t nLights = scene.lights.size();
+    for (size_t r = 0; r < scene.regions.size(); ++r) {
+        const BBox& hull = distances.scatterBounds(int(r));
+        if (!hull.isFinite() || hull.empty()) continue;
+        // Thin media only: in a dense one a path sent towards a beam meets
+        // a collision long before it, and the directions it did not take
+        // by f cost more than they bring (docs/method.md).
+        double depth = 0;
+        for (int mi : scene.regions[r].media) {
+            const Medium& m = *scene.media[size_t(mi)];
+            depth += double(maxComponent(m.sigma_a + m.sigma_s)) * double(m.maxDensity());
+        }
+        if (!(depth * double(length(hull.extent())) <= MaxBeamRegionDepth)) continue;
+        Region& out = mRegions[r];
+        for (size_t i = 0; i < nLights; ++i) {
+            Beam b;  // each maker first checks the light's type
+            if (spotBeam(scene, distances, hull, i, int(r), b) || prismBeam(scene, hull, i, int(r), b))
+                out.beams.push_back(b);
+        }
+        if (out.beams.empty()) continue;
+        const float g = regionPhaseG(scene, int(r));
+        auto it = mAngleIntegrals.find(g);
+        if (it == mAngleIntegrals.end()) it = mAngleIntegrals.emplace(g, phaseAngleIntegral(g)).first;
+        out.angleIntegral = &it->second;
+    }
 }
 
-float beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi) {
-    const ThreadContext::BeamRegion& r = ctx.beamRegions[size_t(region)];
+bool BeamDirections::attach(ThreadContext& ctx, int region, ScatterVertex& v, bool skipPointLights) const {
+    if (!hasBeams(region, skipPointLights)) return false;
+    BeamMixture& m = ctx.extensionAt<Scratch>(mSlot).mixture;
+    m.ctx = &ctx;
+    m.beams = this;
+    m.region = region;
+    m.vertex = &v;
+    m.mBeamWeight = -1;  // the sights are made again for this vertex
+    v.pathPdf = &BeamMixture::pdfOf;
+    v.pathSampler = &m;
+    return true;
+}
+
+Vec3 BeamDirections::sample(ThreadContext& ctx, Rng& rng, Color& weight, float& pdf) const {
+    return ctx.extensionAt<Scratch>(mSlot).mixture.sample(rng, weight, pdf);
+}
+
+float BeamDirections::beamDirectionPdf(ThreadContext& ctx, int region, const Vec3& x, const Vec3& wi) const {
+    const Region& r = mRegions[size_t(region)];
     return float(beamsPdf(
         ctx, r.beams.size(), [&](size_t k) { return BeamView(r.beams[k], *r.angleIntegral, x); }, x, wi));
 }
@@ -378,9 +379,9 @@ double BeamMixture::beamWeight() const {
 float BeamMixture::pdf(const Vec3& wi) const {
     // A vertex that sees no beam (every view's weight zero) keeps f alone.
     if (!(beamWeight() > 0)) return vertex->fPdf(wi);
-    const double beams = beamsPdf(
-        *ctx, ctx->beamRegions[size_t(region)].beams.size(), [&](size_t k) { return viewOf(*this, k); }, vertex->p, wi);
-    return (1 - BeamShare) * vertex->fPdf(wi) + BeamShare * float(beams);
+    const double beamsDensity = beamsPdf(
+        *ctx, beams->region(region).beams.size(), [&](size_t k) { return viewOf(*this, k); }, vertex->p, wi);
+    return (1 - BeamShare) * vertex->fPdf(wi) + BeamShare * float(beamsDensity);
 }
 
 Vec3 BeamMixture::sample(Rng& rng, Color& weight, float& pdfOut) const {
@@ -391,7 +392,7 @@ Vec3 BeamMixture::sample(Rng& rng, Color& weight, float& pdfOut) const {
     if (u < BeamShare && beamWeight() > 0) {
         // A beam by its weight, a bin by its mass (a search on G at the
         // bins' edges), a point along the bin, a point on the disc there.
-        const ThreadContext::BeamRegion& r = ctx->beamRegions[size_t(region)];
+        const BeamDirections::Region& r = beams->region(region);
         double pick = double(u0) * beamWeight();
         size_t k = 0;
         for (; k + 1 < r.beams.size(); ++k) {
@@ -401,7 +402,7 @@ Vec3 BeamMixture::sample(Rng& rng, Color& weight, float& pdfOut) const {
         }
         BeamView view = viewOf(*this, k);
         while (!(view.weight() > 0) && k > 0) view = viewOf(*this, --k);
-        const ThreadContext::Beam& b = r.beams[k];
+        const BeamDirections::Beam& b = r.beams[k];
         const double target = view.sight.g0 + double(u1) * (view.sight.g1 - view.sight.g0);
         int lo = 0, hi = BeamBins;  // G(edge lo) <= target < G(edge hi)
         double gLo = view.sight.g0, gHi = view.sight.g1;

@@ -9,8 +9,8 @@
 // as 1 / sqrt(d): integrable along a ray, but a position drawn by a density
 // that stays bounded there (the histogram, transmittance, equiangular
 // sampling) has weights with a tail as heavy as P(w > v) ~ 1 / v^2, the
-// variance of a log-divergent integral. On fig4_caustic (the paper's figure
-// 4) one such sample in 44 spp made a pixel 10x its value.
+// variance of a log-divergent integral: rare draws near a fold show as
+// fireflies.
 //
 // So a segment that crosses a fold also draws positions near each crossing
 // t_f with the density 1 / (4 sqrt(W |t - t_f|)) over [t_f - W, t_f + W]
@@ -25,7 +25,8 @@
 
 #include <vector>
 
-#include "transport/thread_context.h"
+#include "scene/scene.h"
+#include "strategies/strategy.h"
 
 namespace vdbmarch {
 
@@ -56,15 +57,42 @@ private:
     int mCount = 0;
 };
 
-// True when the scene has folds at all (render.sphere_caustics, point-like
-// or parallel lights outside glass spheres, Scene::deltaLightCaustics), made
-// on the thread's first call (ThreadContext::foldSurfaces).
-bool sceneHasCausticFolds(ThreadContext& ctx);
+// The folds of the scene's point-like and parallel lights through its glass
+// spheres (experiments.sphere_caustics, Scene::deltaLightCaustics), traced
+// once per render, and the distance strategy drawing positions near where a
+// segment crosses them; the tracking collisions keep the complementary
+// share of those lights' connections (CollisionWeights::connectionWeight).
+class CausticFolds final : public DistanceStrategy {
+public:
+    CausticFolds(const Scene& scene, size_t slot);
+    bool empty() const { return mSurfaces.empty(); }
 
-// The crossings of the segment [0, tEnd) of `ray` in `region` with the
-// folds of the spheres around it, inside the region's scattering media, into
-// `out`; false when there are none.
-bool prepareFoldDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, FoldSampler& out);
+    // The crossings of the segment [0, tEnd) of `ray` in `region` with the
+    // folds of the spheres around it, into `out`; false when there are none.
+    bool crossings(int region, const Ray& ray, float tEnd, FoldSampler& out) const;
+
+    bool prepare(ThreadContext& ctx, const PathSegment& seg) const override;
+    Color sample(ThreadContext& ctx, const PathSegment& seg, Rng& rng) const override;
+    float collisionAt(ThreadContext& ctx, float t) const override { return sampler(ctx).offCrossing(t); }
+    void weighCollision(ThreadContext& ctx, const PathSegment& seg, float t, const MediumPoint& mp,
+                        CollisionWeights& w) const override;
+
+private:
+    struct Scratch final : ThreadContextExtension {
+        FoldSampler folds;  // the prepared segment's crossings
+    };
+    FoldSampler& sampler(ThreadContext& ctx) const { return ctx.extensionAt<Scratch>(mSlot).folds; }
+
+    struct Surface {
+        int sphere = -1, light = -1;
+        CausticFold fold;
+        Vec3 boundCenter;
+        float boundRadius = 0, halfWidth = 0;  // a bounding sphere; the density's half-width about a crossing
+    };
+    const Scene& mScene;
+    const size_t mSlot;
+    std::vector<Surface> mSurfaces;
+};
 
 // The crossings of ray o + t d (d unit), t in [t0, t1], with the surface of
 // revolution of `fold`, the fold of light l through sphere s (up to `max`,

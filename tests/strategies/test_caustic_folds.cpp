@@ -1,5 +1,5 @@
 // The folds of point and parallel lights' caustics behind glass spheres
-// (sphere_caustics.h's causticFold, transport/caustic_folds.h), checked
+// (sphere_caustics.h's causticFold, strategies/caustic_folds.h), checked
 // against the connection solver, which knows nothing of them: across the
 // fold the number of connections changes by two, and along a ray through it
 // that change happens at the crossing foldCrossings finds. And FoldSampler's
@@ -11,8 +11,8 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "support/support.h"
-#include "transport/caustic_folds.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/caustic_folds.h"
+#include "strategies/sphere_caustics.h"
 
 namespace vdbmarch {
 namespace {

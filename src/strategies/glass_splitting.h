@@ -1,4 +1,4 @@
-// Glass events of radiance paths (render.glass_splitting): a small light
+// Glass events of radiance paths (experiments.glass_splitting): a small light
 // mirrored in glass is a highlight a thousand times its surroundings'
 // brightness, which the Fresnel choice (reflect with chance F, a few
 // percent) finds in a few of a pixel's samples. So at a glass event

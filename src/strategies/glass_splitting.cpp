@@ -1,4 +1,4 @@
-#include "transport/glass_splitting.h"
+#include "strategies/glass_splitting.h"
 
 #include "transport/transmittance.h"
 
@@ -18,7 +18,7 @@ PathSurfaceEvent pathSurfaceEvent(ThreadContext& ctx, const SurfaceHit& h, const
     const bool reflect = u[0] < F;
     out.event = both.outcome[reflect ? 0 : 1];
     out.weight = out.event.weight;
-    if (!(F > 0 && F < 1) || !scene.desc.render.glassSplitting) return out;
+    if (!(F > 0 && F < 1) || !scene.desc.experiments.glassSplitting) return out;
     const SurfaceEvent& mirror = both.outcome[0];
     if (split) {
         out.split = true;

@@ -1,4 +1,4 @@
-// Directions towards spot and collimated beams (transport/beam_directions.h): the mixture
+// Directions towards spot and collimated beams (strategies/beam_directions.h): the mixture
 // of f's own sampling and the beams draws directions with the density it
 // reports (chi-square on a fine grid of the sphere, the expected counts from
 // pdf() by Gauss-Legendre quadrature per cell), at medium vertices inside
@@ -15,7 +15,8 @@
 #include "scene/scene.h"
 #include "support/sphere_quadrature.h"
 #include "support/support.h"
-#include "transport/beam_directions.h"
+#include "strategies/beam_directions.h"
+#include "strategies/light_distances.h"
 #include "transport/media_point.h"
 
 namespace vdbmarch {
@@ -35,7 +36,7 @@ const char* const kBeamScene = R"({
      "direction": [0.2, -1, -0.1], "irradiance": [3, 3, 3]}],
   "media": [{"name": "haze", "type": "homogeneous", "sigma_a": 0.02, "sigma_s": 0.3, "g": 0.5,
              "bounds": {"min": [-1.5, -1, -1], "max": [1.5, 1, 1]}}],
-  "render": {"method": "reference", "beam_directions": true}
+  "render": {"method": "reference"}, "experiments": {"beam_directions": true}
 })";
 
 using test::fromZPhi;
@@ -47,9 +48,9 @@ struct BeamCase {
     bool surface;
 };
 
-class BeamDirections : public ::testing::TestWithParam<BeamCase> {};
+class BeamMixtureSampling : public ::testing::TestWithParam<BeamCase> {};
 
-TEST_P(BeamDirections, SamplerMatchesItsPdf) {
+TEST_P(BeamMixtureSampling, SamplerMatchesItsPdf) {
     const BeamCase& c = GetParam();
     auto scene = test::sceneFromJson(kBeamScene);
     ThreadContext ctx(*scene);
@@ -57,16 +58,18 @@ TEST_P(BeamDirections, SamplerMatchesItsPdf) {
     MediumPoint mp;
     evalMedia(ctx, region, c.x, mp);
     ASSERT_TRUE(mp.scatters());
-    ASSERT_TRUE(regionHasBeamDirections(ctx, region, false));
-    ASSERT_EQ(ctx.beamRegions[size_t(region)].beams.size(), 3u);
-    ASSERT_TRUE(ctx.beamRegions[size_t(region)].beams[2].prism);
+    const LightDistances distances(*scene, 1);
+    const BeamDirections beams(*scene, distances, 2);
+    ASSERT_TRUE(beams.hasBeams(region, false));
+    ASSERT_EQ(beams.region(region).beams.size(), 3u);
+    ASSERT_TRUE(beams.region(region).beams[2].prism);
     const ScatterVertex v = c.surface ? ScatterVertex::onSurface(c.x, c.d, Vec3(0, 1, 0), Color(0.5f))
                                       : ScatterVertex::inMedium(c.x, c.d, mp.phase);
-    const BeamMixture mix{&ctx, region, &v};
+    const BeamMixture mix(&ctx, &beams, region, &v);
 
     // The beams' own density is a density.
-    const double beamMass = sphereIntegral([&](const Vec3& w) { return double(beamDirectionPdf(ctx, region, c.x, w)); },
-                                           96, 6);
+    const double beamMass =
+        sphereIntegral([&](const Vec3& w) { return double(beams.beamDirectionPdf(ctx, region, c.x, w)); }, 96, 6);
     EXPECT_NEAR(beamMass, 1.0, 0.01) << c.name;
 
     const int nz = 48, np = 96, samples = 2000000;
@@ -126,7 +129,7 @@ TEST_P(BeamDirections, SamplerMatchesItsPdf) {
     EXPECT_GT(chi.p(), 1e-3) << "chi2 " << chi.chi2 << " dof " << chi.dof;
 }
 
-INSTANTIATE_TEST_SUITE_P(Vertices, BeamDirections,
+INSTANTIATE_TEST_SUITE_P(Vertices, BeamMixtureSampling,
                          ::testing::Values(BeamCase{"outside the beams", Vec3(1.1f, -0.4f, 0.6f),
                                                     normalize(Vec3(0.3f, -1, 0.2f)), false},
                                            BeamCase{"inside a beam", Vec3(0.2f, 0.3f, -0.1f),

@@ -1,12 +1,11 @@
-#include "transport/caustic_folds.h"
+#include "strategies/caustic_folds.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
-#include <mutex>
 
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
+#include "transport/direct_light.h"
 
 namespace vdbmarch {
 
@@ -15,63 +14,6 @@ namespace {
 // The half-width of the density around a crossing, in radii of the ball:
 // the fold's 1 / sqrt(d) holds over a fraction of the caustic's size.
 constexpr float FoldHalfWidthRadii = 0.25f;
-
-// The folds, traced once per (sphere, light) geometry in the process
-// (thread contexts are made per block of pixels and sweep).
-std::shared_ptr<const CausticFold> foldOf(const GlassSphere& s, const Light& l) {
-    using Key = std::array<float, 12>;
-    const Vec3& p = l.desc().position;
-    const Vec3& d = l.desc().direction;
-    const Key key{s.center.x, s.center.y, s.center.z, s.radius, s.ior, float(int(l.desc().type)),
-                  p.x,        p.y,        p.z,        d.x,      d.y,   d.z};
-    static std::mutex mutex;
-    static std::map<Key, std::shared_ptr<const CausticFold>> folds;
-    const std::lock_guard<std::mutex> lock(mutex);
-    auto it = folds.find(key);
-    if (it != folds.end()) return it->second;
-    if (folds.size() >= 256) folds.clear();  // a long run over many scenes: keep it small
-    auto fold = std::make_shared<CausticFold>();
-    if (!causticFold(s, l, *fold)) fold.reset();
-    folds[key] = fold;
-    return fold;
-}
-
-void makeFoldSurfaces(ThreadContext& ctx) {
-    ctx.foldSurfacesMade = true;
-    const Scene& scene = ctx.scene;
-    if (!sceneHasSphereCaustics(scene) || !scene.deltaLightCaustics) return;
-    for (size_t si = 0; si < scene.glassSpheres.size(); ++si) {
-        const GlassSphere& s = scene.glassSpheres[si];
-        for (size_t li = 0; li < scene.lights.size(); ++li) {
-            const Light& l = scene.lights[li];
-            if (!l.isDelta()) continue;
-            // A spot whose cone misses the ball casts no caustic through it.
-            if (l.desc().type == LightDesc::Type::Spot) {
-                const Vec3 to = s.center - l.desc().position;
-                const float dist = length(to);
-                if (!(dist > s.radius)) continue;
-                const float reach = radians(l.desc().coneDeg) + std::asin(s.radius / dist);
-                if (!(dot(to / dist, normalize(l.desc().direction)) > std::cos(std::min(reach, Pi)))) continue;
-            }
-            std::shared_ptr<const CausticFold> fold = foldOf(s, l);
-            if (!fold) continue;
-            ThreadContext::FoldSurface f;
-            f.sphere = int(si);
-            f.light = int(li);
-            float zLo = Infinity, zHi = -Infinity, rhoMax = 0;
-            for (size_t k = 0; k < fold->z.size(); ++k) {
-                zLo = std::min(zLo, fold->z[k]);
-                zHi = std::max(zHi, fold->z[k]);
-                rhoMax = std::max(rhoMax, fold->rho[k]);
-            }
-            f.boundCenter = fold->center + fold->axis * (0.5f * (zLo + zHi));
-            f.boundRadius = 1.001f * std::sqrt(0.25f * (zHi - zLo) * (zHi - zLo) + rhoMax * rhoMax) + 1e-6f;
-            f.halfWidth = FoldHalfWidthRadii * s.radius;
-            f.fold = std::move(fold);
-            ctx.foldSurfaces.push_back(std::move(f));
-        }
-    }
-}
 
 }  // namespace
 
@@ -230,17 +172,44 @@ int foldCrossings(const GlassSphere& s, const Light& l, const CausticFold& fold,
     return n;
 }
 
-bool sceneHasCausticFolds(ThreadContext& ctx) {
-    if (!ctx.foldSurfacesMade) makeFoldSurfaces(ctx);
-    return !ctx.foldSurfaces.empty();
+CausticFolds::CausticFolds(const Scene& scene, size_t slot) : mScene(scene), mSlot(slot) {
+    if (!sceneHasSphereCaustics(scene) || !scene.deltaLightCaustics) return;
+    for (size_t si = 0; si < scene.glassSpheres.size(); ++si) {
+        const GlassSphere& s = scene.glassSpheres[si];
+        for (size_t li = 0; li < scene.lights.size(); ++li) {
+            const Light& l = scene.lights[li];
+            if (!l.isDelta()) continue;
+            // A spot whose cone misses the ball casts no caustic through it.
+            if (l.desc().type == LightDesc::Type::Spot) {
+                const Vec3 to = s.center - l.desc().position;
+                const float dist = length(to);
+                if (!(dist > s.radius)) continue;
+                const float reach = radians(l.desc().coneDeg) + std::asin(s.radius / dist);
+                if (!(dot(to / dist, normalize(l.desc().direction)) > std::cos(std::min(reach, Pi)))) continue;
+            }
+            Surface f;
+            if (!causticFold(s, l, f.fold)) continue;
+            f.sphere = int(si);
+            f.light = int(li);
+            float zLo = Infinity, zHi = -Infinity, rhoMax = 0;
+            for (size_t k = 0; k < f.fold.z.size(); ++k) {
+                zLo = std::min(zLo, f.fold.z[k]);
+                zHi = std::max(zHi, f.fold.z[k]);
+                rhoMax = std::max(rhoMax, f.fold.rho[k]);
+            }
+            f.boundCenter = f.fold.center + f.fold.axis * (0.5f * (zLo + zHi));
+            f.boundRadius = 1.001f * std::sqrt(0.25f * (zHi - zLo) * (zHi - zLo) + rhoMax * rhoMax) + 1e-6f;
+            f.halfWidth = FoldHalfWidthRadii * s.radius;
+            mSurfaces.push_back(std::move(f));
+        }
+    }
 }
 
-bool prepareFoldDistances(ThreadContext& ctx, int region, const Ray& ray, float tEnd, FoldSampler& out) {
+bool CausticFolds::crossings(int region, const Ray& ray, float tEnd, FoldSampler& out) const {
     out.clear();
-    if (!sceneHasCausticFolds(ctx)) return false;
-    float crossings[FoldSampler::MaxCrossings];
-    for (const ThreadContext::FoldSurface& f : ctx.foldSurfaces) {
-        if (ctx.scene.glassSpheres[size_t(f.sphere)].outside != region) continue;
+    float t[FoldSampler::MaxCrossings];
+    for (const Surface& f : mSurfaces) {
+        if (mScene.glassSpheres[size_t(f.sphere)].outside != region) continue;
         // The bounding sphere first: most segments pass far from a fold.
         const Vec3 oc = ray.o - f.boundCenter;
         const float b = dot(oc, ray.d), c = dot(oc, oc) - f.boundRadius * f.boundRadius, disc = b * b - c;
@@ -248,11 +217,35 @@ bool prepareFoldDistances(ThreadContext& ctx, int region, const Ray& ray, float 
         const float h = std::sqrt(disc);
         const float a0 = std::max(0.f, -b - h), a1 = std::min(tEnd, -b + h);
         if (!(a1 > a0)) continue;
-        const int n = foldCrossings(ctx.scene.glassSpheres[size_t(f.sphere)], ctx.scene.lights[size_t(f.light)], *f.fold,
-                                    ray, a0, a1, crossings, FoldSampler::MaxCrossings - out.count());
-        for (int i = 0; i < n; ++i) out.add(crossings[i], f.halfWidth);
+        const int n = foldCrossings(mScene.glassSpheres[size_t(f.sphere)], mScene.lights[size_t(f.light)], f.fold, ray,
+                                    a0, a1, t, FoldSampler::MaxCrossings - out.count());
+        for (int i = 0; i < n; ++i) out.add(t[i], f.halfWidth);
     }
     return !out.empty();
+}
+
+bool CausticFolds::prepare(ThreadContext& ctx, const PathSegment& seg) const {
+    return crossings(seg.region, seg.ray, seg.tEnd, sampler(ctx));
+}
+
+Color CausticFolds::sample(ThreadContext& ctx, const PathSegment& seg, Rng& rng) const {
+    const FoldSampler& folds = sampler(ctx);
+    if (folds.empty()) return Color(0);
+    const float t = folds.sample(rng.uniform());
+    if (!(t > 0 && t < seg.tEnd)) return Color(0);
+    // The connections of sphereCausticLight's delta part (point-like lights
+    // only where the vertices connect them).
+    return scatteredAt(ctx, seg, t, float(folds.pdf(t)), false, rng, [&](const ScatterVertex& v) {
+        return sphereCausticLight(ctx, seg.region, v, rng, TransmittanceEstimator::UnbiasedMarching,
+                                  {false, !seg.skipPointLights, false, true});
+    });
+}
+
+void CausticFolds::weighCollision(ThreadContext& ctx, const PathSegment& seg, float t, const MediumPoint& mp,
+                                  CollisionWeights& w) const {
+    const FoldSampler& folds = sampler(ctx);
+    if (folds.empty()) return;
+    w.connectionWeight = 1 - distanceWeight(float(folds.pdf(t)), trackingDensity(ctx, seg, t, mp));
 }
 
 }  // namespace vdbmarch

@@ -1,4 +1,4 @@
-// Sphere caustic connections (transport/sphere_caustics.h): the solver's
+// Sphere caustic connections (strategies/sphere_caustics.h): the solver's
 // connections against the traced rays, and the connection estimate of the
 // light a glass ball focuses from a sphere light onto a point against
 // brute force (directions drawn uniformly in the cone of the ball, traced
@@ -12,7 +12,7 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "support/support.h"
-#include "transport/sphere_caustics.h"
+#include "strategies/sphere_caustics.h"
 
 namespace vdbmarch {
 namespace {

@@ -49,79 +49,10 @@
 #pragma once
 
 #include "core/rng.h"
-#include "scene/scene.h"
-#include "transport/direct_light.h"
+#include "strategies/sphere_connections.h"
+#include "strategies/strategy.h"
 
 namespace vdbmarch {
-
-// A connection from x through a glass sphere to a point y.
-struct SphereConnection {
-    Vec3 wi;             // unit, from x to the entry point p1
-    Vec3 p1, p2;         // entry and exit points
-    Vec3 wo;             // unit, from p2 towards y
-    float transmission;  // (1 - F1)(1 - F2), the Fresnel transmittances
-    double spreading;    // G = dA_perp(y) / d omega(x); to a light at infinity, d omega_exit / d omega(x)
-    int refractions;     // 2: into the ball and out; 1: across its surface (p1 = p2)
-};
-
-// Most connections one (x, y) pair can have through a sphere.
-constexpr int MaxSphereConnections = 8;
-
-// Every connection from x to y through sphere s that the solver finds (x and
-// y outside it); returns their number. A grid over the arc of the ball's
-// outline brackets the roots. Two roots closer than its step (near a fold
-// of the caustic) or three near the lens's axis can slip through it: sphere
-// lights weigh the connections against two other ways to the same light,
-// so a missed root only moves weight to them; a point light has no other
-// way, so `thorough` also finds pairs between the grid's points (at local
-// minima of |h|), the arc's ends and a finer grid near the axis
-// (SphereCaustics.TheSolverFindsEveryTracedPathFromAPoint: without these,
-// 0.8 % of a point light's paths through the ball were missed); with every
-// solve thorough, fig4_caustic_sphere rendered 10-16 % slower.
-int connectThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections],
-                         bool thorough = false);
-
-// Every connection across the surface of sphere s from x to y, one inside
-// it and one outside (one refraction); returns their number. The roots are
-// found on the arc of the outline that the outer end sees; `thorough` as
-// above. On the axis through the outer end and the centre the one path is
-// the axis (a point light at the centre of a glass globe).
-int connectAcrossSphere(const GlassSphere& s, const Vec3& x, const Vec3& y, SphereConnection out[MaxSphereConnections],
-                        bool thorough = false);
-
-// Every connection from x to a light at infinity in direction wL (unit,
-// towards the light: directional and collimated lights) through sphere s
-// from outside it (two refractions), or across its surface from inside it
-// (one); solved thoroughly. Each connection's `spreading` is then
-// J = d omega_exit / d omega(x), and its estimate f E T (1 - F...) / J.
-int connectThroughSphereToward(const GlassSphere& s, const Vec3& x, const Vec3& wL,
-                               SphereConnection out[MaxSphereConnections]);
-int connectAcrossSphereToward(const GlassSphere& s, const Vec3& x, const Vec3& wL,
-                              SphereConnection out[MaxSphereConnections]);
-
-// Traces direction w from x into sphere s and out again (double precision):
-// the exit point and direction, the Fresnel transmittances. False when the
-// ray misses the sphere.
-bool traceThroughSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out);
-
-// Traces direction w from x across the surface of sphere s once (into it
-// from outside, out of it from inside). False when the ray misses it or is
-// totally reflected.
-bool traceAcrossSphere(const GlassSphere& s, const Vec3& x, const Vec3& w, SphereConnection& out);
-
-// Which lights sphereCausticLight connects to, and whether the path goes on
-// from the vertex (its hits of sphere lights through the glass then weigh
-// against the connections, sphereCausticPathWeight; else the connections
-// and the cone directions share the light between them alone).
-struct CausticLights {
-    bool sphereLights = true;
-    bool pointLights = true;     // where Scene::deltaLightCaustics holds
-    bool pathFollows = true;
-    bool parallelLights = true;  // directional and collimated, where Scene::deltaLightCaustics holds
-    // The share of the point-like and parallel lights' connections left to
-    // this vertex by distance sampling near caustic folds (light_distance.h).
-    float deltaWeight = 1;
-};
 
 // The caustic light at vertex v (in `region`) through every glass sphere:
 // from sphere lights, the connections to one light point (and through the
@@ -130,7 +61,7 @@ struct CausticLights {
 // point; from directional and collimated lights, those along their
 // direction.
 Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
-                         TransmittanceEstimator estimator, const CausticLights& lights = {});
+                         TransmittanceEstimator estimator, const ConnectionRequest& lights = {});
 
 // The power-heuristic weight of a path that left x along w (its direction
 // density pathPdf), refracted `refractions` times at glass sphere `sphere`
@@ -155,19 +86,27 @@ inline void followLensPattern(const Scene& scene, bool refraction, int surface, 
     }
 }
 
-// The fold (scene.h's CausticFold) of light `light` through sphere s,
-// traced through the ball in double precision (the envelope by central differences along the family
-// of the light's rays); false when the light is not point-like or parallel,
-// or lies inside or on the ball.
-bool causticFold(const GlassSphere& s, const Light& light, CausticFold& out);
-// The fold's exact point (z, rho) for the light's ray of parameter u;
-// false where there is none.
-bool causticFoldPoint(const GlassSphere& s, const Light& light, double u, double& z, double& rho);
-
-// True when sphere caustic connections apply (render.sphere_caustics, a
+// True when sphere caustic connections apply (experiments.sphere_caustics, a
 // sphere light or Scene::deltaLightCaustics, a glass sphere): every vertex
 // then makes them, through each sphere by where it and the light lie, so a
 // path's weights (sphereCausticPathWeight) know what its last vertex did.
 bool sceneHasSphereCaustics(const Scene& scene);
+
+// Sphere caustic connections as a connection strategy of the path loops.
+class SphereCaustics final : public ConnectionStrategy {
+public:
+    explicit SphereCaustics(const Scene& scene) : mScene(scene), mActive(sceneHasSphereCaustics(scene)) {}
+    bool active() const override { return mActive; }
+    Color connect(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
+                  const ConnectionRequest& request) const override {
+        return sphereCausticLight(ctx, region, v, rng, TransmittanceEstimator::UnbiasedMarching, request);
+    }
+    float pathHitWeight(const SpecularChain& chain, int light, const Vec3& x, const Vec3& w, float pathPdf,
+                        const Vec3& y) const override;
+
+private:
+    const Scene& mScene;
+    const bool mActive;
+};
 
 }  // namespace vdbmarch

@@ -1,0 +1,303 @@
+#include "paths/path_tracer.h"
+
+#include <algorithm>
+
+#include "strategies/glass_splitting.h"
+#include "transport/media_point.h"
+#include "transport/roulette.h"
+#include "transport/surface_event.h"
+#include "transport/tracking.h"
+
+namespace vdbmarch {
+
+namespace {
+
+// A free flight in a region of constant media seldom goes far where they
+// are dense (milk sealed in glass: mean free paths far shorter than the
+// glass): the surface is looked for only within ProbeFreePaths mean free
+// paths, where Embree prunes most of its tree, and a path that passes them
+// without a collision goes on from there. Delta tracking is memoryless, so
+// the cut changes no distribution; it is made only where no distance
+// strategy reads the segment's end.
+constexpr float ProbeFreePaths = 3;
+
+// A new vertex at x from which the path samples its next direction: its
+// connections (made there when `connected`) start a new specular chain.
+void startVertex(PathState& st, const Vec3& x, const Vec3& wi, float pdf, bool connected) {
+    st.lastPdf = pdf;
+    st.lastDir = wi;
+    st.specular = false;
+    st.lastPoint = x;
+    st.connectedAtLast = connected;
+    st.chain.clear();
+    st.mirrorCounted = false;
+}
+
+// Russian roulette on the throughput after RouletteMinDepth events.
+bool roulette(Color& beta, const PathState& st, Rng& rng) {
+    return st.depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold, st.rouletteScale);
+}
+
+// The state after a reflection or refraction at surface `surface`.
+void followSurfaceEvent(const SurfaceEvent& e, int surface, PathState& st) {
+    if (e.straight) return;
+    st.specular = true;  // next-event estimation cannot see through this
+    st.chain.add(surface, e.kind == SurfaceEvent::Kind::Refract);
+}
+
+}  // namespace
+
+// One path through the loop: its state, throughput and sums, and the
+// events of PathTracer::trace.
+class PathWalk {
+public:
+    PathWalk(const PathTracer& t, ThreadContext& c, Ray r, int reg, int ch, Rng& g, PathState s)
+        : tracer(t), scene(t.mScene), strategies(*t.mStrategies), ctx(c), rng(g), ray(r), region(reg), channel(ch),
+          st(s), startDepth(s.depth), maxDepth(t.mScene.desc.render.maxDepth) {}
+
+    // Adds c, after `events` scattering events, to L (and to the direct part).
+    void add(const Color& c, int events) {
+        L += c;
+        if (events <= 1) direct += c;
+    }
+    // Emission and lights seen before any scattering event, too.
+    void addEmitted(const Color& c, int events) {
+        add(c, events);
+        if (events == 0) emitted += c;
+    }
+    PathRadiance result(float transmittance) const { return PathRadiance{L, transmittance, direct, emitted}; }
+
+    float probeLength() const;
+    void sampleDistances(const PathSegment& seg);
+    bool scatterAt(Vec3 x, float t, const MediumPoint& mp, const PathSegment& seg);
+    void hitLight(int light, float tEnd);
+    bool surfaceEvent(const SurfaceHit& h);
+
+    const PathTracer& tracer;
+    const Scene& scene;
+    const StrategySet& strategies;
+    ThreadContext& ctx;
+    Rng& rng;
+    Ray ray;
+    int region, channel;
+    PathState st;
+    const int startDepth, maxDepth;
+    Color L{0}, beta{1}, direct{0}, emitted{0};
+    unsigned prepared = 0;  // bit i: distance strategy i prepared the current segment
+
+private:
+    bool nextEvent(const ScatterVertex& vertex, const CollisionWeights& w);
+};
+
+float PathWalk::probeLength() const {
+    const Region& r = scene.regions[size_t(region)];
+    if (!r.constant) return Infinity;
+    const float sigmaT = trackedSigmaT(r.unboundedSigmaT, channel);
+    if (!(sigmaT > 0) || strategies.needsSegmentEnd(region, tracer.mOptions.pointLightsByPhotons)) return Infinity;
+    return ProbeFreePaths / sigmaT;
+}
+
+// The distance strategies' samples along the segment, each weighed against
+// the tracking collisions by MIS.
+void PathWalk::sampleDistances(const PathSegment& seg) {
+    prepared = 0;
+    if (st.depth >= maxDepth) return;
+    const auto& distances = strategies.distances();
+    for (size_t i = 0; i < distances.size(); ++i) {
+        if (!distances[i]->prepare(ctx, seg)) continue;
+        prepared |= 1u << i;
+        add(beta * distances[i]->sample(ctx, seg, rng), st.depth + 1);
+    }
+}
+
+// Next-event estimation at a vertex of the path, then the connections
+// through specular surfaces; true when some connection was made (the
+// path's own light hits through such surfaces weigh against it).
+bool PathWalk::nextEvent(const ScatterVertex& vertex, const CollisionWeights& w) {
+    const bool byPhotons = tracer.mOptions.pointLightsByPhotons;
+    DirectLightOptions o{TransmittanceEstimator::UnbiasedMarching, true, false, byPhotons, w.lightWeights};
+    o.phaseRoulette = true;
+    add(beta * directLight(ctx, region, vertex, rng, o), st.depth);
+    bool connected = false;
+    for (const ConnectionStrategy* c : strategies.connections()) {
+        if (!c->active()) continue;
+        add(beta * c->connect(ctx, region, vertex, rng, {true, !byPhotons, true, true, w.connectionWeight}), st.depth);
+        connected = true;
+    }
+    return connected;
+}
+
+// A real scattering event at x (media mp there): next-event estimation,
+// then the next direction. False when max_depth ends the path.
+bool PathWalk::scatterAt(Vec3 x, float t, const MediumPoint& mp, const PathSegment& seg) {
+    if (++st.depth > maxDepth) {
+        beta = Color(0);
+        return false;
+    }
+    const auto& distances = strategies.distances();
+    CollisionWeights weights;
+    for (size_t i = 0; i < distances.size(); ++i) {
+        if (!(prepared >> i & 1u)) continue;
+        const float moved = distances[i]->collisionAt(ctx, t);  // off a singular point
+        if (moved != t) t = moved, x = ray.at(t);
+    }
+    ScatterVertex vertex = ScatterVertex::inMedium(x, ray.d, mp.phase);
+    const DirectionStrategy* directions = tracer.attachDirections(ctx, region, vertex);
+    for (size_t i = 0; i < distances.size(); ++i)
+        if (prepared >> i & 1u) distances[i]->weighCollision(ctx, seg, t, mp, weights);
+    const bool connected = nextEvent(vertex, weights);
+    if (tracer.mOptions.firstVertexLight && st.firstVertexPending) {
+        add(beta * tracer.mOptions.firstVertexLight->at(x, region, -ray.d, mp.phase), st.depth);
+        st.firstVertexPending = false;
+    }
+    float pdf = 0;
+    Vec3 wi;
+    if (directions) {
+        wi = directions->sample(ctx, rng, beta, pdf);
+        scaleRoulette(st, vertex, wi, pdf);
+    } else {
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        wi = mp.phase.sample(ray.d, u0, u1, u2, beta, pdf);
+    }
+    startVertex(st, x, wi, pdf, connected);
+    ray = Ray{x, wi};
+    return true;
+}
+
+// The path hit sphere light `light` at tEnd: its emission, weighed against
+// the next-event estimate at the last vertex (a sampled direction) or
+// against the connections through the specular chain since (power heuristic).
+void PathWalk::hitLight(int light, float tEnd) {
+    const Light& l = scene.lights[size_t(light)];
+    float w = 1;
+    if (!st.specular) {
+        w = powerHeuristic(st.lastPdf, l.directionPdf(st.lastPoint));
+    } else if (st.connectedAtLast) {
+        for (const ConnectionStrategy* c : strategies.connections())
+            if (c->active()) w *= c->pathHitWeight(st.chain, light, st.lastPoint, st.lastDir, st.lastPdf, ray.at(tEnd));
+    }
+    if (!st.mirrorCounted) addEmitted(beta * l.emittedRadiance() * w, st.depth);
+}
+
+// The shared surface event at h; false when the path ends there.
+bool PathWalk::surfaceEvent(const SurfaceHit& h) {
+    ++ctx.counters.surfaceHits;
+    if (++st.surfaceBounces > scene.desc.render.maxSurfaceBounces) return false;
+    const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
+    // Glass may split a camera path, or count the light its reflection
+    // sees (glass_splitting.h).
+    const bool split = st.depth == 0 && st.glassSplits < SplitDielectricEvents;
+    const PathSurfaceEvent pe = pathSurfaceEvent(ctx, h, ray.d, region, u, split, st.depth == 0, rng);
+    add(beta * pe.light, st.depth);
+    st.mirrorCounted = pe.mirrorCounted;
+    if (pe.split) {
+        ++st.glassSplits;
+        PathState sr = st;
+        followSurfaceEvent(pe.mirror, h.surface, sr);
+        const Color br = beta * pe.mirrorWeight;
+        sr.rouletteScale = std::min(sr.rouletteScale * average(br), 1e20f);
+        const PathRadiance pr = tracer.trace(ctx, pe.mirror.ray, pe.mirror.region, channel, rng, sr);
+        L += br * pr.L;
+        direct += br * pr.direct;
+        emitted += br * pr.emitted;
+    }
+    const SurfaceEvent& e = pe.event;
+    Color weight = pe.weight;
+    Ray next = e.ray;
+    const bool diffuse = e.kind == SurfaceEvent::Kind::Diffuse;
+    if (diffuse) {
+        if (++st.depth > maxDepth) return false;
+        const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
+        ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
+        const DirectionStrategy* directions = tracer.attachDirections(ctx, region, vertex);
+        const bool connected = nextEvent(vertex, CollisionWeights{});
+        float pdf = e.pdf;
+        if (directions) {
+            weight = Color(1);
+            next.d = directions->sample(ctx, rng, weight, pdf);
+            if (isBlack(weight)) return false;  // a direction below the surface
+            next.o = offsetRayOrigin(scene, h.p, vertex.arrivalNormal(), next.d);
+            scaleRoulette(st, vertex, next.d, pdf);
+        }
+        startVertex(st, h.p, next.d, pdf, connected);
+    } else {
+        followSurfaceEvent(e, h.surface, st);
+    }
+    beta *= weight;
+    ray = next;
+    region = e.region;
+    return !diffuse || roulette(beta, st, rng);
+}
+
+PathTracer::PathTracer(const Scene& scene, std::shared_ptr<const StrategySet> strategies, PathOptions options)
+    : mScene(scene), mStrategies(std::move(strategies)), mOptions(options) {}
+
+const DirectionStrategy* PathTracer::attachDirections(ThreadContext& ctx, int region, ScatterVertex& v) const {
+    for (const DirectionStrategy* d : mStrategies->directions())
+        if (d->attach(ctx, region, v, mOptions.pointLightsByPhotons)) return d;
+    return nullptr;
+}
+
+void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float pdf) {
+    const float pf = v.fPdf(wi);
+    if (pf > 0 && pdf > 0) st.rouletteScale = std::min(st.rouletteScale * (pdf / pf), 1e20f);
+}
+
+PathRadiance PathTracer::trace(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state) const {
+    PathWalk w(*this, ctx, ray, region, channel, rng, state);
+    MediumPoint mp;
+    while (true) {
+        const RaySegment seg = nextRaySegment(mScene, w.ray, w.probeLength());
+        const PathSegment path{w.ray, w.region, channel, seg.tEnd, mOptions.pointLightsByPhotons};
+        w.sampleDistances(path);
+        // Delta tracking to the next real collision, or to tEnd; the
+        // collision callback returns false once the path scattered or was
+        // absorbed.
+        bool scattered = false;
+        deltaTrack(ctx, w.region, w.ray, seg.tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+            evalMedia(ctx, w.region, x, mp);
+            ++ctx.counters.marchSamples;
+            // Emission: sigma_a L_e / sigma_maj at every tentative collision.
+            if (!isBlack(mp.emission)) w.addEmitted(w.beta * mp.sigma_a * mp.emission / sigmaMaj, w.st.depth);
+            const float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
+            const float u = rng.uniform() * sigmaMaj;
+            if (u < sa) {
+                w.beta = Color(0);  // absorbed
+                return false;
+            }
+            if (u >= sa + ss) return true;  // null collision
+            // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
+            w.beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+            scattered = w.scatterAt(x, dot(x - w.ray.o, w.ray.d), mp, path);
+            return false;
+        });
+        if (isBlack(w.beta)) return w.result(0.f);
+        if (scattered) {
+            if (!roulette(w.beta, w.st, rng)) return w.result(0.f);
+            continue;
+        }
+        // Reached tEnd without a real collision.
+        if (seg.cut) {  // the end of the probed length: the same free flight goes on
+            w.ray.o = w.ray.at(seg.tEnd);
+            continue;
+        }
+        if (seg.light >= 0) {
+            w.hitLight(seg.light, seg.tEnd);
+            return w.result(0.f);
+        }
+        if (!seg.hitSurface) {
+            // An environment map was also sampled by next-event estimation
+            // at the last vertex (direct_light.cpp): weigh the two by MIS.
+            const Environment& env = mScene.environment;
+            const PathState& st = w.st;
+            const float mis = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(w.ray.d)) : 1.f;
+            // A camera path that never scattered sees the map as a backdrop.
+            if (!st.mirrorCounted)
+                w.add(w.beta * (st.depth == 0 ? env.radianceSeen(w.ray.d) : env.radiance(w.ray.d)) * mis, st.depth);
+            return w.result(st.depth == w.startDepth && st.surfaceBounces == 0 ? average(w.beta) : 0.f);
+        }
+        if (!w.surfaceEvent(seg.surface)) return w.result(0.f);
+    }
+}
+
+}  // namespace vdbmarch
