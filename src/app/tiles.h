@@ -22,7 +22,7 @@ inline constexpr const char* PassSamplesAttribute = "vdbmarch:passSamples";  // 
 // Hash of everything that decides the pixels: the effective scene without
 // render.threads (which never changes a pixel), the version and the cache.
 inline constexpr const char* RenderHashAttribute = "vdbmarch:renderHash";
-// The noise estimate from the two halves (render/render.h NoiseEstimate):
+// The noise estimate from the two halves (render/noise_estimate.h NoiseEstimate):
 // its relative value, RMSE and mean, which merge combines over tiles.
 inline constexpr const char* NoiseAttribute = "vdbmarch:noiseEstimate";
 inline constexpr const char* NoiseRmseAttribute = "vdbmarch:noiseRmse";

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -178,6 +179,31 @@ void writeCheckpointFile(const std::string& path, const CheckpointIdentity& id, 
         if (!out) throw IoError(str(path, ": cannot write: ", std::strerror(errno)));
     }
     file.commit();
+}
+
+void saveCheckpoint(const CheckpointHooks& hooks, RenderCheckpoint& c, Film& film) {
+    c.sums = std::move(film.sums);
+    c.open = std::move(film.open);
+    c.passSums = std::move(film.passSums);
+    c.aovs = std::move(film.aovs);
+    struct GiveBack {
+        RenderCheckpoint& c;
+        Film& film;
+        ~GiveBack() {
+            film.sums = std::move(c.sums);
+            film.open = std::move(c.open);
+            film.passSums = std::move(c.passSums);
+            film.aovs = std::move(c.aovs);
+        }
+    } giveBack{c, film};
+    hooks.save(c);
+}
+
+void resumeFilm(const RenderCheckpoint& c, Film& film) {
+    film.sums = c.sums;
+    film.open = c.open;
+    film.passSums = c.passSums;
+    film.aovs = c.aovs;
 }
 
 RenderCheckpoint readCheckpointFile(const std::string& path, const CheckpointIdentity& expected) {

@@ -9,11 +9,47 @@
 // truncated or damaged file before anything is parsed.
 #pragma once
 
+#include <functional>
 #include <string>
+#include <vector>
 
-#include "render/render.h"
+#include "core/stats.h"
+#include "render/film.h"
 
 namespace vdbmarch {
+
+// Everything a render has accumulated at a sample boundary (the photon pass
+// it was at follows from nextSample): samples
+// [firstSample, nextSample) of every pixel are in the sums.
+struct RenderCheckpoint {
+    int nextSample = 0;
+    double seconds = 0;   // the run's time so far (counts in --time)
+    RenderCounters counters;
+    PixelSums sums{0};
+    PhotonPassSums open;                    // the pass being rendered (pass -1: none)
+    std::vector<PhotonPassSums> passSums;   // with RenderOptions::photonPassRange: the passes closed so far
+    AovSums aovs;
+};
+
+// Checkpoints (render --checkpoint, docs/farm.md): at sample boundaries the
+// render hands its whole state to `save`, every `everySeconds` and when
+// `stopRequested` says so (a signal); then, if a stop was requested, it
+// returns with RenderResult::interrupted set. A render given `resume`
+// continues from that state: its image is bit-identical to an
+// uninterrupted one.
+struct CheckpointHooks {
+    double everySeconds = 300;
+    std::function<void(const RenderCheckpoint&)> save;
+    std::function<bool()> stopRequested;
+    const RenderCheckpoint* resume = nullptr;
+};
+
+// Hands a running render's state to hooks.save: `c` (sample, time and
+// counters filled in) with the film's sums lent to it, not copied (a large
+// frame's are hundreds of megabytes), and taken back even if saving throws.
+void saveCheckpoint(const CheckpointHooks& hooks, RenderCheckpoint& c, Film& film);
+// The film of a render resumed from `c`: a copy of its sums.
+void resumeFilm(const RenderCheckpoint& c, Film& film);
 
 // What a checkpoint belongs to; every field must match to resume.
 struct CheckpointIdentity {

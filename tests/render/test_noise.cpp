@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "denoise/denoise.h"
+#include "render/adaptive_sampling.h"
 #include "support/support.h"
 
 namespace vdbmarch::test {
