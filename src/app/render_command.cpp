@@ -183,13 +183,10 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     return s.dump(2) + "\n";
 }
 
-// One render: the whole command for one frame (`frame` set by --frames, its
-// paths already substituted in `a`) or without frames.
-int renderFrame(const RenderArgs& a, std::optional<int> frame) {
-    auto t0 = std::chrono::steady_clock::now();
-    validate(a);
-    // Command-line options are overrides of the scene document, so they are
-    // validated by the same parser and recorded in the output.
+// The scene overrides the command line gives. Command-line options are
+// overrides of the scene document, so they are validated by the same parser
+// and recorded in the output.
+std::vector<std::string> commandLineOverrides(const RenderArgs& a) {
     std::vector<std::string> overrides = a.sets;
     appendSceneOverrides(a, renderSceneOptions(), overrides);
     if (!a.res.empty()) overrides.push_back(resolutionOverride(a.res));
@@ -197,11 +194,12 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (a.noise && !a.spp && !a.timeBudget) overrides.push_back(str("render.spp=", MaxNoiseTargetSpp));
     if (a.denoise) overrides.push_back("render.denoise=\"on\"");
     if (a.noDenoise) overrides.push_back("render.denoise=\"off\"");
-    if (!a.cache.empty() && !endsWith(a.cache, ".vdb"))
-        throw InputError(str("--cache ", a.cache, ": the cache must be a .vdb file written by vdbmarch bake"));
-    if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
+    return overrides;
+}
 
-    if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
+// The scene with the command line's overrides; with --preview, loaded again
+// with the preview's on top (they depend on the scene's own values).
+SceneDesc loadRenderScene(const RenderArgs& a, std::vector<std::string>& overrides, std::optional<int> frame) {
     SceneDesc desc = loadSceneInput(a.input, overrides, frame);
     if (a.preview) {
         // A quick look: the same scene with a quarter of the pixels, an
@@ -210,15 +208,18 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         overrides.insert(overrides.end(), p.begin(), p.end());
         desc = loadSceneInput(a.input, overrides, frame);
     }
-    const TileRequest tile = parseTileRequest(a.tile, a.crop, a.passes);
-    const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
-    // The emitted part's sums, where a denoised render of the scene may keep them.
-    const bool emitted = desc.render.denoise != RenderSettings::Denoise::Off && sceneEmitsLight(desc);
-    checkImageMemory(window.width(), window.height(), desc.render.aovs, emitted);  // before any volume is loaded
-    const uint64_t predictedMemory = checkRenderMemory(desc, window, emitted);
-    std::unique_ptr<Scene> scene = buildScene(desc);
-    double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return desc;
+}
 
+// Whether the frame is denoised in this process (not after merge).
+bool denoisesHere(const RenderArgs& a, RenderSettings::Denoise mode) {
+    return mode == RenderSettings::Denoise::On || (mode == RenderSettings::Denoise::Preview && !a.png.empty());
+}
+
+// The render's options: budget, window, the halves the denoiser needs and,
+// for a timed render denoised here, the time kept back for it.
+RenderOptions renderOptions(const RenderArgs& a, const SceneDesc& desc, const TileRequest& tile,
+                            const PixelRect& window, std::chrono::steady_clock::time_point t0) {
     RenderOptions options;
     options.illumination.cacheFile = a.cache;
     options.illumination.force = a.force;
@@ -232,8 +233,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     // The denoiser (docs/denoise.md) works on the two half renders: of the
     // whole frame here, of a tile's after merge (a tile alone would show seams).
     const RenderSettings::Denoise denoiseMode = desc.render.denoise;
-    const bool denoiseHere = denoiseMode == RenderSettings::Denoise::On ||
-                             (denoiseMode == RenderSettings::Denoise::Preview && !a.png.empty());
+    const bool denoiseHere = denoisesHere(a, denoiseMode);
     options.keepHalves = tile.any() ? denoiseMode != RenderSettings::Denoise::Off && !tile.byPasses() : denoiseHere;
     // The emission seen straight is denoised apart (docs/denoise.md), where
     // the scene has emissive media or sphere lights the camera can see.
@@ -256,51 +256,82 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
             return variances;
         };
     }
+    return options;
+}
 
-    // Checkpoints: resume from the file when it is there (--resume: it must
-    // be), save to it every --checkpoint-every seconds and on a signal.
-    const std::string checkpointPath = a.resume.empty() ? a.checkpoint : a.resume;
-    std::optional<RenderCheckpoint> resumed;
+// A render's checkpoint file (--checkpoint, --resume): what identifies the
+// render in it, and the state resumed from it. The hooks refer to it, so it
+// lives as long as the render.
+struct Checkpointing {
+    std::string path;
     CheckpointIdentity identity;
-    if (!checkpointPath.empty()) {
-        identity.version = VDBMARCH_VERSION;
-        identity.renderHash = renderHash(desc, a.cache);
-        identity.window = str(window.x0, ",", window.y0, ",", window.x1, ",", window.y1);
-        identity.budget = options.timeBudget > 0 ? str("time ", options.timeBudget, " s")
-                          : tile.byPasses()      ? str("passes ", a.passes, " of ", desc.render.spp, " spp")
-                                                 : str("spp ", desc.render.spp);
-        if (desc.render.noise > 0) identity.budget += str(", noise ", desc.render.noise);
-        if (::access(checkpointPath.c_str(), F_OK) == 0) {
-            resumed = readCheckpointFile(checkpointPath, identity);
-            if (resumed->sums.L.size() != size_t(window.width()) * size_t(window.height()))
-                throw InputError(str(checkpointPath, ": the checkpoint holds ", resumed->sums.L.size(),
-                                     " pixels, this render ", window.width() * window.height(), " (damaged)"));
-            if (!a.quiet)
-                std::fprintf(stderr, "vdbmarch: resuming from %s at sample %d (%.1f s spent)\n", checkpointPath.c_str(),
-                             resumed->nextSample, resumed->seconds);
-        } else if (!a.resume.empty()) {
-            throw InputError(str("--resume ", a.resume, ": no such checkpoint (render with --checkpoint ", a.resume,
-                                 " to write one)"));
-        }
-        CheckpointHooks hooks;
-        hooks.everySeconds = a.checkpointEvery.value_or(DefaultCheckpointSeconds);
-        hooks.save = [&](const RenderCheckpoint& c) { writeCheckpointFile(checkpointPath, identity, c); };
-        hooks.stopRequested = [] { return stopSignal() != 0; };
-        hooks.resume = resumed ? &*resumed : nullptr;
-        options.checkpoint = std::move(hooks);
-        stopGracefullyOnSignals();
-    }
-    RenderResult r = renderImage(*scene, options);
-    if (r.interrupted) {
-        if (!a.quiet)
-            std::fprintf(stderr, "vdbmarch: stopped by %s after %d samples per pixel; the state is in %s: run the "
-                                 "same command to resume (exit status %d)\n",
-                         strsignal(stopSignal()), r.firstSample + r.spp, checkpointPath.c_str(), ExitCheckpointed);
-        return ExitCheckpointed;
-    }
-    if (r.counters.nonFiniteSamples > 0)
-        warn(str(r.counters.nonFiniteSamples, " path sample(s) gave NaN or Inf and were dropped"));
+    std::optional<RenderCheckpoint> resumed;
+};
 
+// Resumes from the checkpoint file when it is there (--resume: it must be),
+// and saves to it every --checkpoint-every seconds and on a signal.
+void setUpCheckpoints(const RenderArgs& a, const SceneDesc& desc, const TileRequest& tile, const PixelRect& window,
+                      Checkpointing& cp, RenderOptions& options) {
+    CheckpointIdentity& identity = cp.identity;
+    identity.version = VDBMARCH_VERSION;
+    identity.renderHash = renderHash(desc, a.cache);
+    identity.window = str(window.x0, ",", window.y0, ",", window.x1, ",", window.y1);
+    identity.budget = options.timeBudget > 0 ? str("time ", options.timeBudget, " s")
+                      : tile.byPasses()      ? str("passes ", a.passes, " of ", desc.render.spp, " spp")
+                                             : str("spp ", desc.render.spp);
+    if (desc.render.noise > 0) identity.budget += str(", noise ", desc.render.noise);
+    if (::access(cp.path.c_str(), F_OK) == 0) {
+        cp.resumed = readCheckpointFile(cp.path, identity);
+        if (cp.resumed->sums.L.size() != size_t(window.width()) * size_t(window.height()))
+            throw InputError(str(cp.path, ": the checkpoint holds ", cp.resumed->sums.L.size(), " pixels, this render ",
+                                 window.width() * window.height(), " (damaged)"));
+        if (!a.quiet)
+            std::fprintf(stderr, "vdbmarch: resuming from %s at sample %d (%.1f s spent)\n", cp.path.c_str(),
+                         cp.resumed->nextSample, cp.resumed->seconds);
+    } else if (!a.resume.empty()) {
+        throw InputError(str("--resume ", a.resume, ": no such checkpoint (render with --checkpoint ", a.resume,
+                             " to write one)"));
+    }
+    CheckpointHooks hooks;
+    hooks.everySeconds = a.checkpointEvery.value_or(DefaultCheckpointSeconds);
+    hooks.save = [&cp](const RenderCheckpoint& c) { writeCheckpointFile(cp.path, cp.identity, c); };
+    hooks.stopRequested = [] { return stopSignal() != 0; };
+    hooks.resume = cp.resumed ? &*cp.resumed : nullptr;
+    options.checkpoint = std::move(hooks);
+    stopGracefullyOnSignals();
+}
+
+// Denoises the rendered frame where this process does (not a tile's: merge
+// does), the halves joining the layers either way; returns the seconds it
+// took, or -1. `preview` becomes the denoised image.
+double denoiseRendered(RenderResult& r, const RenderOptions& options, RenderSettings::Denoise mode,
+                       const TileRequest& tile, int threads, Image& preview) {
+    if (!options.keepHalves) return -1;
+    if (r.spp < 2) {
+        warn(str("not denoised: the denoiser needs at least 2 samples per pixel (", r.spp, " rendered)"));
+        return -1;
+    }
+    // The halves join the layers, which are the denoiser's input (the AOV
+    // features among them). The EXR keeps them with the denoised RGBA and
+    // the noisy beauty; a tile keeps its noisy RGBA and the halves for
+    // merge; a preview-only EXR drops them again.
+    appendHalfLayers(r.layers, std::move(r.evenHalf), std::move(r.oddHalf), r.emittedEven, r.emittedOdd);
+    if (tile.any()) return -1;
+    const auto d0 = std::chrono::steady_clock::now();
+    preview = denoiseFrame(r.image.width, r.image.height, r.layers, threads);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+    if (mode == RenderSettings::Denoise::On) {
+        r.layers.push_back(rgbaLayer(NoisyLayer, r.image));
+        r.image = preview;
+    } else {
+        r.layers.erase(std::remove_if(r.layers.begin(), r.layers.end(), isDenoiserInput), r.layers.end());
+    }
+    return seconds;
+}
+
+// The EXR's metadata: how the frame was made, and the scene it was made of.
+StringAttributes exrAttributes(const RenderArgs& a, const SceneDesc& desc, const Scene& scene, const TileRequest& tile,
+                               const RenderResult& r) {
     StringAttributes attrs = {
         {"vdbmarch:version", VDBMARCH_VERSION},
         {"vdbmarch:source", desc.file},
@@ -309,8 +340,8 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         {"vdbmarch:photonPasses", std::to_string(r.photonPasses)},
         {"vdbmarch:timeBudget", a.timeBudget ? str(*a.timeBudget) : std::string("none")},
         {"vdbmarch:seed", std::to_string(desc.render.seed)},
-        {"vdbmarch:step", str(scene->step)},
-        {"vdbmarch:shadowStep", str(scene->shadowStep)},
+        {"vdbmarch:step", str(scene.step)},
+        {"vdbmarch:shadowStep", str(scene.shadowStep)},
         {"vdbmarch:renderSeconds", str(r.seconds)},
         {"vdbmarch:scene", desc.jsonText},
         {RenderHashAttribute, renderHash(desc, a.cache)},
@@ -318,32 +349,74 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
         {"vdbmarch:meanSpp", str(r.meanSpp)},
     };
     for (auto& kv : noiseAttributes(r.noise)) attrs.push_back(std::move(kv));
-    attrs.emplace_back(DenoiseAttribute, denoiseModeName(denoiseMode));
-    Image preview = r.image;
-    double denoiseSeconds = -1;
-    if (options.keepHalves && r.spp < 2) {
-        warn(str("not denoised: the denoiser needs at least 2 samples per pixel (", r.spp, " rendered)"));
-    } else if (options.keepHalves) {
-        // The halves join the layers, which are the denoiser's input (the
-        // AOV features among them). The EXR keeps them with the denoised
-        // RGBA and the noisy beauty; a tile keeps its noisy RGBA and the
-        // halves for merge; a preview-only EXR drops them again.
-        appendHalfLayers(r.layers, std::move(r.evenHalf), std::move(r.oddHalf), r.emittedEven, r.emittedOdd);
-        if (!tile.any()) {
-            const auto d0 = std::chrono::steady_clock::now();
-            preview = denoiseFrame(r.image.width, r.image.height, r.layers, desc.render.threads);
-            denoiseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
-            if (denoiseMode == RenderSettings::Denoise::On) {
-                r.layers.push_back(rgbaLayer(NoisyLayer, r.image));
-                r.image = preview;
-            } else {
-                r.layers.erase(std::remove_if(r.layers.begin(), r.layers.end(), isDenoiserInput), r.layers.end());
-            }
-        }
-    }
+    attrs.emplace_back(DenoiseAttribute, denoiseModeName(desc.render.denoise));
     if (desc.frame) attrs.emplace_back("vdbmarch:frame", std::to_string(*desc.frame));
     if (!a.cache.empty()) attrs.emplace_back("vdbmarch:cache", a.cache);
     for (auto& kv : tileAttributes(tile, r)) attrs.push_back(std::move(kv));
+    return attrs;
+}
+
+// The summary line on stderr: what was rendered, how, in how long, and where to.
+void printSummary(const RenderArgs& a, const SceneDesc& desc, const Scene& scene, const TileRequest& tile,
+                  const RenderResult& r, double loadSeconds, double total, double denoiseSeconds) {
+    std::fprintf(stderr, "vdbmarch: %s%dx%d, %s, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s%s\n",
+                 tile.count > 0 ? str("tile ", tile.index, "/", tile.count, " (rows ", r.window.y0, "-", r.window.y1 - 1, ") of ").c_str()
+                 : tile.cropped ? str("crop ", a.crop, " of ").c_str()
+                 : tile.byPasses() ? str("photon passes ", a.passes, " (samples ", r.firstSample, "-", r.firstSample + r.spp - 1, ") of ").c_str() : "",
+                 scene.camera->width(), scene.camera->height(),
+                 (r.meanSpp < r.spp - 0.05 ? str(r.spp, " spp (", std::round(r.meanSpp * 10) / 10, " on average)")
+                                           : str(r.spp, " spp")).c_str(),
+                 methodLabel(desc.render).c_str(), double(scene.step),
+                 r.seconds,
+                 r.illuminationSeconds > 0
+                     ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s in ",
+                           r.photonPasses, r.photonPasses == 1 ? " pass, " : " passes, ").c_str()
+                     : "",
+                 loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str(),
+                 (noiseSummary(desc.render, r) +
+                  (denoiseSeconds >= 0 ? str("; denoised in ", std::round(denoiseSeconds * 1000) / 1000, " s") : ""))
+                     .c_str());
+}
+
+// One render: the whole command for one frame (`frame` set by --frames, its
+// paths already substituted in `a`) or without frames.
+int renderFrame(const RenderArgs& a, std::optional<int> frame) {
+    auto t0 = std::chrono::steady_clock::now();
+    validate(a);
+    std::vector<std::string> overrides = commandLineOverrides(a);
+    if (!a.cache.empty() && !endsWith(a.cache, ".vdb"))
+        throw InputError(str("--cache ", a.cache, ": the cache must be a .vdb file written by vdbmarch bake"));
+    if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
+
+    if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
+    const SceneDesc desc = loadRenderScene(a, overrides, frame);
+    const TileRequest tile = parseTileRequest(a.tile, a.crop, a.passes);
+    const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
+    // The emitted part's sums, where a denoised render of the scene may keep them.
+    const bool emitted = desc.render.denoise != RenderSettings::Denoise::Off && sceneEmitsLight(desc);
+    checkImageMemory(window.width(), window.height(), desc.render.aovs, emitted);  // before any volume is loaded
+    const uint64_t predictedMemory = checkRenderMemory(desc, window, emitted);
+    std::unique_ptr<Scene> scene = buildScene(desc);
+    double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    RenderOptions options = renderOptions(a, desc, tile, window, t0);
+    Checkpointing checkpoint;
+    checkpoint.path = a.resume.empty() ? a.checkpoint : a.resume;
+    if (!checkpoint.path.empty()) setUpCheckpoints(a, desc, tile, window, checkpoint, options);
+    RenderResult r = renderImage(*scene, options);
+    if (r.interrupted) {
+        if (!a.quiet)
+            std::fprintf(stderr, "vdbmarch: stopped by %s after %d samples per pixel; the state is in %s: run the "
+                                 "same command to resume (exit status %d)\n",
+                         strsignal(stopSignal()), r.firstSample + r.spp, checkpoint.path.c_str(), ExitCheckpointed);
+        return ExitCheckpointed;
+    }
+    if (r.counters.nonFiniteSamples > 0)
+        warn(str(r.counters.nonFiniteSamples, " path sample(s) gave NaN or Inf and were dropped"));
+
+    Image preview = r.image;
+    const double denoiseSeconds = denoiseRendered(r, options, desc.render.denoise, tile, desc.render.threads, preview);
+    const StringAttributes attrs = exrAttributes(a, desc, *scene, tile, r);
     if (tile.byPasses()) r.layers = passLayers(r);
     writeExr(a.output, r.image, attrs, r.layers,
              ExrWindow{r.window, PixelRect{0, 0, scene->camera->width(), scene->camera->height()}});
@@ -352,25 +425,8 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total, predictedMemory,
                                                                   denoiseSeconds, options.reserveSeconds));
-    if (!checkpointPath.empty() && !a.keepCheckpoint) std::remove(checkpointPath.c_str());  // the render is whole
-    if (!a.quiet)
-        std::fprintf(stderr, "vdbmarch: %s%dx%d, %s, method %s, step %g: rendered in %.3f s (%sload %.3f s, total %.3f s) -> %s%s%s%s\n",
-                     tile.count > 0 ? str("tile ", tile.index, "/", tile.count, " (rows ", r.window.y0, "-", r.window.y1 - 1, ") of ").c_str()
-                     : tile.cropped ? str("crop ", a.crop, " of ").c_str()
-                     : tile.byPasses() ? str("photon passes ", a.passes, " (samples ", r.firstSample, "-", r.firstSample + r.spp - 1, ") of ").c_str() : "",
-                     scene->camera->width(), scene->camera->height(),
-                     (r.meanSpp < r.spp - 0.05 ? str(r.spp, " spp (", std::round(r.meanSpp * 10) / 10, " on average)")
-                                               : str(r.spp, " spp")).c_str(),
-                     methodLabel(desc.render).c_str(), double(scene->step),
-                     r.seconds,
-                     r.illuminationSeconds > 0
-                         ? str("photons and cache ", std::round(r.illuminationSeconds * 1000) / 1000, " s in ",
-                               r.photonPasses, r.photonPasses == 1 ? " pass, " : " passes, ").c_str()
-                         : "",
-                     loadSeconds, total, a.output.c_str(), a.png.empty() ? "" : ", ", a.png.c_str(),
-                     (noiseSummary(desc.render, r) +
-                      (denoiseSeconds >= 0 ? str("; denoised in ", std::round(denoiseSeconds * 1000) / 1000, " s") : ""))
-                         .c_str());
+    if (!checkpoint.path.empty() && !a.keepCheckpoint) std::remove(checkpoint.path.c_str());  // the render is whole
+    if (!a.quiet) printSummary(a, desc, *scene, tile, r, loadSeconds, total, denoiseSeconds);
     return 0;
 }
 
