@@ -15,13 +15,14 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "denoise/denoise.h"
-#include "illumination/illumination.h"
-#include "transport/media_point.h"
-#include "transport/roulette.h"
 #include "estimators/estimator.h"
 #include "estimators/segment_marcher.h"
-#include "scene/scene.h"
+#include "illumination/illumination.h"
 #include "parse/scene_desc.h"
+#include "scene/scene.h"
+#include "transport/media_point.h"
+#include "transport/phase.h"
+#include "transport/roulette.h"
 #include "volume/medium.h"
 
 using namespace vdbmarch;

@@ -12,6 +12,7 @@
 #include "cache/sh.h"
 #include "photons/photon_tracer.h"
 #include "transport/media_point.h"
+#include "transport/phase.h"
 #include "transport/surface_event.h"
 
 namespace vdbmarch {

@@ -64,35 +64,38 @@ void insertCacheKeys(openvdb::MetaMap& m, const RadianceCache& c) {
 // What the numbers mean, for other tools (file metadata only); the basis
 // is the one of cache/sh.h, whose tests check these statements.
 void insertBasisKeys(openvdb::MetaMap& m) {
-    m.insertMeta("description", openvdb::StringMetadata(
-        "vdbmarch radiance cache: spherical-harmonics coefficients of the in-scattered radiance L_i at cell "
-        "centres (one float grid per coefficient and level), and L_i averaged over directions (grid Li)"));
-    m.insertMeta("Li_quantity", openvdb::StringMetadata(
-        "in-scattered radiance L_i(x, wo) = integral over w of p(w . wo) L(x, w) dw (eq. 3): incident radiance "
-        "L over the travel direction w of the arriving light, convolved with the phase function p (eq. 27), "
-        "so the phase function is already applied; wo is the direction the scattered light travels in "
-        "(towards a viewer at e: wo = normalize(e - x)). Estimated from the volume photon map; scalar: the "
-        "mean of the RGB channels. The radiance scattered towards wo per unit length is sigma_s(x) L_i(x, wo)"));
-    m.insertMeta("Li_unit", openvdb::StringMetadata("W m^-2 sr^-1 (radiance in the scene's units)"));
-    m.insertMeta("Li_reconstruction", openvdb::StringMetadata(
-        "L_i(x, wo) = sum over l = 0..sh_order, m = -l..l of Li_sh_<l>_<m>(x) Y_lm(wo); "
-        "mean over directions = Li_sh_0_0(x) Y_00 = grid Li"));
-    m.insertMeta("sh_basis", openvdb::StringMetadata(
-        "real spherical harmonics, orthonormal on the unit sphere, Condon-Shortley phase included, z the polar "
-        "axis (theta = acos z, phi = atan2(y, x)): Y_l0 = K_l0 P_l^0(cos theta); "
-        "Y_lm = sqrt(2) K_lm P_l^m(cos theta) cos(m phi) for m > 0; "
-        "Y_lm = sqrt(2) K_l|m| P_l^|m|(cos theta) sin(|m| phi) for m < 0; "
-        "K_lm = sqrt((2l+1)/(4 pi) (l-|m|)!/(l+|m|)!); P_l^m with the (-1)^m phase. "
-        "So Y_00 = 0.282095, Y_1,-1 = -0.488603 y, Y_1,0 = 0.488603 z, Y_1,1 = -0.488603 x "
-        "(Sloan, Stupid Spherical Harmonics Tricks, 2008)"));
-    m.insertMeta("sh_normalisation", openvdb::StringMetadata(
-        "orthonormal: integral over the unit sphere of Y_lm Y_l'm' = 1 if (l, m) = (l', m') else 0"));
+    static const char* const kText[][2] = {
+        {"description",
+         "vdbmarch radiance cache: spherical-harmonics coefficients of the in-scattered radiance L_i at cell "
+         "centres (one float grid per coefficient and level), and L_i averaged over directions (grid Li)"},
+        {"Li_quantity",
+         "in-scattered radiance L_i(x, wo) = integral over w of p(w . wo) L(x, w) dw (eq. 3): incident radiance "
+         "L over the travel direction w of the arriving light, convolved with the phase function p (eq. 27), "
+         "so the phase function is already applied; wo is the direction the scattered light travels in "
+         "(towards a viewer at e: wo = normalize(e - x)). Estimated from the volume photon map; scalar: the "
+         "mean of the RGB channels. The radiance scattered towards wo per unit length is sigma_s(x) L_i(x, wo)"},
+        {"Li_unit", "W m^-2 sr^-1 (radiance in the scene's units)"},
+        {"Li_reconstruction",
+         "L_i(x, wo) = sum over l = 0..sh_order, m = -l..l of Li_sh_<l>_<m>(x) Y_lm(wo); "
+         "mean over directions = Li_sh_0_0(x) Y_00 = grid Li"},
+        {"sh_basis",
+         "real spherical harmonics, orthonormal on the unit sphere, Condon-Shortley phase included, z the polar "
+         "axis (theta = acos z, phi = atan2(y, x)): Y_l0 = K_l0 P_l^0(cos theta); "
+         "Y_lm = sqrt(2) K_lm P_l^m(cos theta) cos(m phi) for m > 0; "
+         "Y_lm = sqrt(2) K_l|m| P_l^|m|(cos theta) sin(|m| phi) for m < 0; "
+         "K_lm = sqrt((2l+1)/(4 pi) (l-|m|)!/(l+|m|)!); P_l^m with the (-1)^m phase. "
+         "So Y_00 = 0.282095, Y_1,-1 = -0.488603 y, Y_1,0 = 0.488603 z, Y_1,1 = -0.488603 x "
+         "(Sloan, Stupid Spherical Harmonics Tricks, 2008)"},
+        {"sh_normalisation",
+         "orthonormal: integral over the unit sphere of Y_lm Y_l'm' = 1 if (l, m) = (l', m') else 0"},
+        {"sh_coefficient_order",
+         "band by band, c = l(l+1) + m for l = 0..sh_order, m = -l..l (metadata sh_coefficient of each grid)"},
+        {"sh_grid_names",
+         "Li_sh_<l>_<m>, a negative m spelt m<|m|> (Li_sh_1_m1 is l = 1, m = -1); adaptive caches add "
+         "_level<n> (level 0 the coarsest, each level halves the cell), and Li becomes Li_level<n>"},
+    };
+    for (const auto& [key, text] : kText) m.insertMeta(key, openvdb::StringMetadata(text));
     m.insertMeta("sh_condon_shortley_phase", openvdb::BoolMetadata(true));
-    m.insertMeta("sh_coefficient_order", openvdb::StringMetadata(
-        "band by band, c = l(l+1) + m for l = 0..sh_order, m = -l..l (metadata sh_coefficient of each grid)"));
-    m.insertMeta("sh_grid_names", openvdb::StringMetadata(
-        "Li_sh_<l>_<m>, a negative m spelt m<|m|> (Li_sh_1_m1 is l = 1, m = -1); adaptive caches add "
-        "_level<n> (level 0 the coarsest, each level halves the cell), and Li becomes Li_level<n>"));
 }
 
 // A trailer after the VDB data (OpenVDB readers ignore trailing bytes): a tag

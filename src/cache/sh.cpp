@@ -161,18 +161,6 @@ void gaussLegendre(int n, std::vector<double>& x, std::vector<double>& w) {
     if (n % 2 == 1) x[n / 2] = 0;
 }
 
-// HG in Legendre series: with the generating function
-//   1 / sqrt(1 - 2 g u + g^2) = sum_l g^l P_l(u)
-// and its derivative in g one finds
-//   (1 - g^2) / (1 - 2 g u + g^2)^{3/2} = sum_l (2l+1) g^l P_l(u),
-// so hgPhase(u) = sum_l (2l+1)/(4 pi) g^l P_l(u). With orthogonality,
-// Int P_k P_l du = 2/(2l+1) delta_kl, eq. 26 gives
-//   w'_l = 2 pi (2l+1)/(4 pi) g^l 2/(2l+1) = g^l.
-void hgLegendreWeights(int order, float g, float* out) {
-    out[0] = 1;
-    for (int l = 1; l <= order; ++l) out[l] = out[l - 1] * g;
-}
-
 void phaseLegendreWeights(int order, const std::function<double(double)>& phase, double* out,
                           int nodes) {
     std::vector<double> x, w;

@@ -15,7 +15,7 @@
 //
 // Directions: the cache stores the incident radiance L(w') over the light's
 // *travel* direction w'; the phase function argument is dot(w', w) with w the
-// scattered direction, matching hgPhase() in core/sampling.h.
+// scattered direction, matching hgPhase() in transport/phase.h.
 #pragma once
 
 #include <algorithm>
@@ -59,9 +59,6 @@ void legendrePolynomials(int order, double x, double* out);
 // n-point Gauss-Legendre nodes (ascending) and weights on [-1, 1]; exact for
 // polynomials of degree <= 2n - 1.
 void gaussLegendre(int n, std::vector<double>& x, std::vector<double>& w);
-
-// Eq. 26 for Henyey-Greenstein, in closed form: w'_l = g^l, l = 0..order.
-void hgLegendreWeights(int order, float g, float* out);
 
 // Eq. 26, w'_l = 2 pi Int_{-1}^{1} p(u) P_l(u) du, by Gauss-Legendre
 // quadrature for any phase function p(u) normalised over the sphere

@@ -5,23 +5,6 @@
 
 namespace vdbmarch {
 
-// Henyey-Greenstein phase function, p(cos) with cos = dot(wo, wi) where both
-// point away from the scattering point along the light flow convention used
-// here: cosTheta is the cosine between the incoming light's travel direction
-// and the outgoing direction (g > 0 scatters forward).
-inline float hgPhase(float cosTheta, float g) {
-    float denom = 1 + g * g - 2 * g * cosTheta;
-    return Inv4Pi * (1 - g * g) / (denom * std::sqrt(std::max(denom, 1e-12f)));
-}
-
-// Samples the cosine to the travel direction with pdf hgPhase(cos, g) over the
-// sphere (times the uniform azimuth). u in [0,1).
-inline float sampleHgCosTheta(float u, float g) {
-    if (std::fabs(g) < 1e-3f) return 1 - 2 * u;
-    float s = (1 - g * g) / (1 - g + 2 * g * u);
-    return clamp((1 + g * g - s * s) / (2 * g), -1.f, 1.f);
-}
-
 // Direction around `axis` with the given cosine and azimuth u2 in [0,1).
 inline Vec3 directionAround(const Vec3& axis, float cosTheta, float u2) {
     Vec3 s, t;

@@ -31,7 +31,7 @@ std::unique_ptr<Estimator> makeEstimator(Method method, const Scene& scene, std:
         if (method == e.method) {
             if (!illumination) illumination = std::make_shared<Illumination>(prepareIllumination(scene, method));
             if (!strategies) strategies = StrategySet::build(scene);
-            return e.make(scene, std::move(illumination), std::move(strategies));
+            return e.make(EstimatorInputs{scene, std::move(illumination), std::move(strategies)});
         }
     throw std::logic_error(str("no marcher for method ", methodName(method)));
 }

@@ -35,16 +35,18 @@ std::unique_ptr<Estimator> makeEstimator(Method method, const Scene& scene,
                                          std::shared_ptr<const Illumination> illumination = nullptr,
                                          std::shared_ptr<const StrategySet> strategies = nullptr);
 
+// What every estimator is made from.
+struct EstimatorInputs {
+    const Scene& scene;
+    std::shared_ptr<const Illumination> illumination;
+    std::shared_ptr<const StrategySet> strategies;
+};
+
 // Constructors behind the factory table.
-using EstimatorMaker = std::unique_ptr<Estimator> (*)(const Scene&, std::shared_ptr<const Illumination>,
-                                                      std::shared_ptr<const StrategySet>);
-std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                              std::shared_ptr<const StrategySet> strategies);
-std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                                    std::shared_ptr<const StrategySet> strategies);
-std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                             std::shared_ptr<const StrategySet> strategies);
-std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                               std::shared_ptr<const StrategySet> strategies);
+using EstimatorMaker = std::unique_ptr<Estimator> (*)(const EstimatorInputs&);
+std::unique_ptr<Estimator> makeUniformMarcher(const EstimatorInputs& in);
+std::unique_ptr<Estimator> makeTransmittanceMarcher(const EstimatorInputs& in);
+std::unique_ptr<Estimator> makeGuidedMarcher(const EstimatorInputs& in);
+std::unique_ptr<Estimator> makeReferenceTracer(const EstimatorInputs& in);
 
 }  // namespace vdbmarch

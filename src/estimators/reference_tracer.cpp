@@ -34,11 +34,11 @@ private:
 
 class ReferenceTracer final : public Estimator {
 public:
-    ReferenceTracer(const Scene& s, std::shared_ptr<const Illumination> il, std::shared_ptr<const StrategySet> strategies)
-        : mScene(s), mChromatic(hasChromaticExtinction(s)), mIllumination(std::move(il)),
+    explicit ReferenceTracer(const EstimatorInputs& in)
+        : mScene(in.scene), mChromatic(hasChromaticExtinction(in.scene)), mIllumination(in.illumination),
           mCaustics(mIllumination && mIllumination->causticsOnly ? std::make_unique<CausticPhotons>(*mIllumination)
                                                                  : nullptr),
-          mPaths(s, std::move(strategies), PathOptions{false, mCaustics.get()}) {}
+          mPaths(in.scene, in.strategies, PathOptions{false, mCaustics.get()}) {}
 
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
         ++ctx.counters.cameraRays;
@@ -66,9 +66,6 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeReferenceTracer(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                               std::shared_ptr<const StrategySet> strategies) {
-    return std::make_unique<ReferenceTracer>(scene, std::move(il), std::move(strategies));
-}
+std::unique_ptr<Estimator> makeReferenceTracer(const EstimatorInputs& in) { return std::make_unique<ReferenceTracer>(in); }
 
 }  // namespace vdbmarch

@@ -59,12 +59,12 @@ constexpr double FoldDistanceShare = 0.15;
 
 class SampledMarcher final : public SegmentMarcher {
 public:
-    SampledMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
-                   std::shared_ptr<const StrategySet> strategies, bool guided)
-        : SegmentMarcher(scene, std::move(il), std::move(strategies)),
+    SampledMarcher(const EstimatorInputs& in, bool guided)
+        : SegmentMarcher(in),
           mGuided(guided && mIllumination->cache),
-          mLightShare(mGuided && scene.desc.experiments.volumeSampling != VolumeSampling::Distance ? LightDistanceShare
-                                                                                              : 0.0) {
+          mLightShare(mGuided && in.scene.desc.experiments.volumeSampling != VolumeSampling::Distance
+                          ? LightDistanceShare
+                          : 0.0) {
         if (mGuided) mMeanGuided = measureMeanGuided();
     }
 
@@ -256,14 +256,10 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeTransmittanceMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                                    std::shared_ptr<const StrategySet> strategies) {
-    return std::make_unique<SampledMarcher>(scene, std::move(il), std::move(strategies), false);
+std::unique_ptr<Estimator> makeTransmittanceMarcher(const EstimatorInputs& in) {
+    return std::make_unique<SampledMarcher>(in, false);
 }
 
-std::unique_ptr<Estimator> makeGuidedMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                             std::shared_ptr<const StrategySet> strategies) {
-    return std::make_unique<SampledMarcher>(scene, std::move(il), std::move(strategies), true);
-}
+std::unique_ptr<Estimator> makeGuidedMarcher(const EstimatorInputs& in) { return std::make_unique<SampledMarcher>(in, true); }
 
 }  // namespace vdbmarch

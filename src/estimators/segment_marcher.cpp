@@ -12,11 +12,11 @@
 
 namespace vdbmarch {
 
-SegmentMarcher::SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination,
-                               std::shared_ptr<const StrategySet> strategies)
-    : mScene(scene), mIllumination(std::move(illumination)), mChromatic(hasChromaticExtinction(scene)),
-      mTallyDirect(scene.desc.render.aovs.splitDirect()),
-      mPaths(scene, std::move(strategies), PathOptions{mIllumination && mIllumination->pointLightsByPhotons, nullptr}) {
+SegmentMarcher::SegmentMarcher(const EstimatorInputs& in)
+    : mScene(in.scene), mIllumination(in.illumination), mChromatic(hasChromaticExtinction(in.scene)),
+      mTallyDirect(in.scene.desc.render.aovs.splitDirect()),
+      mPaths(in.scene, in.strategies, PathOptions{mIllumination && mIllumination->pointLightsByPhotons, nullptr}) {
+    const Scene& scene = in.scene;
     // Without emissive media or refracting glass, the light arriving at a
     // sample straight from its first direction is what next-event estimation
     // samples (lights and the background).

@@ -52,8 +52,7 @@ struct MarcherScratch final : ThreadContextExtension {
 
 class SegmentMarcher : public Estimator {
 public:
-    SegmentMarcher(const Scene& scene, std::shared_ptr<const Illumination> illumination,
-                   std::shared_ptr<const StrategySet> strategies);
+    explicit SegmentMarcher(const EstimatorInputs& in);
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
 
 private:

@@ -64,9 +64,6 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> makeUniformMarcher(const Scene& scene, std::shared_ptr<const Illumination> il,
-                                              std::shared_ptr<const StrategySet> strategies) {
-    return std::make_unique<UniformMarcher>(scene, std::move(il), std::move(strategies));
-}
+std::unique_ptr<Estimator> makeUniformMarcher(const EstimatorInputs& in) { return std::make_unique<UniformMarcher>(in); }
 
 }  // namespace vdbmarch

@@ -1,4 +1,5 @@
 #include "strategies/sphere_connections.h"
+#include "strategies/sphere_trace.h"
 
 #include <cmath>
 
@@ -7,89 +8,9 @@
 
 namespace vdbmarch {
 
+using namespace sphere_trace;
+
 namespace {
-
-// Double-precision vectors: the roots and the spreading's central
-// differences need more digits than float keeps.
-struct D3 {
-    double x = 0, y = 0, z = 0;
-    D3() = default;
-    D3(double a, double b, double c) : x(a), y(b), z(c) {}
-    explicit D3(const Vec3& v) : x(v.x), y(v.y), z(v.z) {}
-    D3 operator+(const D3& o) const { return {x + o.x, y + o.y, z + o.z}; }
-    D3 operator-(const D3& o) const { return {x - o.x, y - o.y, z - o.z}; }
-    D3 operator*(double s) const { return {x * s, y * s, z * s}; }
-    Vec3 f() const { return Vec3(float(x), float(y), float(z)); }
-};
-double dot(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-D3 cross(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-double length(const D3& a) { return std::sqrt(dot(a, a)); }
-D3 normalize(const D3& a) { return a * (1 / length(a)); }
-
-// Refraction of unit d at unit normal n facing the arriving ray, eta =
-// n_transmitted / n_incident; F the Fresnel reflectance (core/sampling.h's
-// formula). False on total internal reflection.
-bool refract(const D3& d, const D3& n, double eta, D3& t, double& F) {
-    const double cosI = std::min(1.0, std::max(0.0, -dot(d, n)));
-    const double sin2T = (1 - cosI * cosI) / (eta * eta);
-    if (sin2T >= 1) return false;
-    const double cosT = std::sqrt(1 - sin2T);
-    const double rPar = (eta * cosI - cosT) / (eta * cosI + cosT);
-    const double rPerp = (cosI - eta * cosT) / (cosI + eta * cosT);
-    F = 0.5 * (rPar * rPar + rPerp * rPerp);
-    t = normalize(d * (1 / eta) + n * (cosI / eta - cosT));
-    return true;
-}
-
-struct Traced {
-    D3 p1, p2, wo;
-    double transmission = 0;
-};
-
-// The ray x + t w into sphere s and out again.
-bool trace(const GlassSphere& s, const D3& x, const D3& w, Traced& out) {
-    const D3 c(s.center);
-    const double R = s.radius;
-    const D3 oc = x - c;
-    const double b = dot(w, oc), cc = dot(oc, oc) - R * R;
-    const double disc = b * b - cc;
-    if (!(cc > 0) || !(disc > 0) || !(b < 0)) return false;  // inside, missed, or behind
-    const double t1 = -b - std::sqrt(disc);
-    out.p1 = x + w * t1;
-    const D3 n1 = (out.p1 - c) * (1 / R);
-    D3 d1;
-    double F1, F2;
-    if (!refract(w, n1, s.ior, d1, F1)) return false;
-    // The chord along d1 from p1 (|p1 - c| = R).
-    const double chord = -2 * dot(out.p1 - c, d1);
-    if (!(chord > 0)) return false;
-    out.p2 = out.p1 + d1 * chord;
-    const D3 n2 = (out.p2 - c) * (1 / R);
-    if (!refract(d1, n2 * -1.0, 1 / double(s.ior), out.wo, F2)) return false;
-    out.transmission = (1 - F1) * (1 - F2);
-    return true;
-}
-
-// The ray x + t w across the surface of sphere s once: into it from
-// outside, or out of it from inside.
-bool traceAcross(const GlassSphere& s, const D3& x, const D3& w, Traced& out) {
-    const D3 c(s.center);
-    const double R = s.radius;
-    const D3 oc = x - c;
-    const double b = dot(w, oc), cc = dot(oc, oc) - R * R;
-    const double disc = b * b - cc;
-    if (!(disc > 0)) return false;
-    const bool entering = cc > 0;
-    if (entering && !(b < 0)) return false;  // the ball behind x
-    const double t = entering ? -b - std::sqrt(disc) : -b + std::sqrt(disc);
-    out.p1 = out.p2 = x + w * t;
-    const D3 n = (out.p1 - c) * (1 / R);  // outwards
-    double F;
-    if (!(entering ? refract(w, n, s.ior, out.wo, F) : refract(w, n * -1.0, 1 / double(s.ior), out.wo, F)))
-        return false;  // total internal reflection
-    out.transmission = 1 - F;
-    return true;
-}
 
 // Bracketing grid (cells) over the outline's arc that x sees, and refinement steps.
 constexpr int RootGrid = 24;
@@ -506,93 +427,5 @@ int connectAcrossSphereToward(const GlassSphere& s, const Vec3& xf, const Vec3& 
     return n;
 }
 
-namespace {
-
-// The family of a point-like or parallel light's rays through sphere s in
-// one plane (a, e) through the axis: from the light's point at angle u off
-// the axis, or parallel to the axis at height u; and the envelope of their
-// exit rays, the caustic's fold.
-struct FoldFamily {
-    D3 c, a, e, source;
-    bool parallel = false, valid = false;
-    double uMax = 0;
-    const GlassSphere* s = nullptr;
-
-    FoldFamily(const GlassSphere& sphere, const Light& light) : c(sphere.center), s(&sphere) {
-        parallel = light.isDelta() && !light.isPointLike();
-        if (!parallel && !light.isPointLike()) return;
-        const double R = sphere.radius;
-        if (parallel) {
-            a = normalize(D3(light.desc().direction));
-            uMax = R;
-        } else {
-            source = D3(light.desc().position);
-            const double D = length(c - source);
-            if (!(D > R * (1 + 1e-6))) return;
-            a = (c - source) * (1 / D);
-            uMax = std::asin(R / D);
-        }
-        const D3 helper = std::fabs(a.x) > 0.9 ? D3(0, 1, 0) : D3(1, 0, 0);
-        e = normalize(cross(a, helper));
-        valid = true;
-    }
-
-    bool exitRay(double u, double& pz, double& pr, double& uz, double& ur) const {
-        const D3 x = parallel ? c - a * (2 * double(s->radius)) + e * u : source;
-        const D3 w = parallel ? a : a * std::cos(u) + e * std::sin(u);
-        Traced tr;
-        if (!trace(*s, x, w, tr)) return false;
-        pz = dot(tr.p2 - c, a);
-        pr = dot(tr.p2 - c, e);
-        uz = dot(tr.wo, a);
-        ur = dot(tr.wo, e);
-        return true;
-    }
-
-    // Where exit rays u and u + du meet, P + lambda U with
-    // (P' + lambda U') x U = 0 (2D cross products, central differences);
-    // false where they meet before the exit (no fold outside) or u's ray
-    // misses the ball.
-    bool point(double u, double& z, double& rho) const {
-        const double h = uMax * 1e-6;
-        double pz, pr, uz, ur, pz0, pr0, uz0, ur0, pz1, pr1, uz1, ur1;
-        if (!exitRay(u, pz, pr, uz, ur) || !exitRay(u - h, pz0, pr0, uz0, ur0) || !exitRay(u + h, pz1, pr1, uz1, ur1))
-            return false;
-        const double dpz = (pz1 - pz0) / (2 * h), dpr = (pr1 - pr0) / (2 * h);
-        const double duz = (uz1 - uz0) / (2 * h), dur = (ur1 - ur0) / (2 * h);
-        const double den = duz * ur - dur * uz;
-        const double lambda = den != 0 ? -(dpz * ur - dpr * uz) / den : -1.0;
-        if (!(lambda > 0) || !std::isfinite(lambda)) return false;
-        z = pz + lambda * uz;
-        rho = std::fabs(pr + lambda * ur);
-        return true;
-    }
-};
-
-}  // namespace
-
-bool causticFold(const GlassSphere& s, const Light& light, CausticFold& out) {
-    const FoldFamily family(s, light);
-    if (!family.valid) return false;
-    out = CausticFold{s.center, family.a.f(), {}, {}, {}};
-    constexpr int Samples = 256;
-    for (int i = 0; i < Samples; ++i) {
-        const double u = family.uMax * (double(i) + 0.5) / Samples * 0.999;
-        double z, rho;
-        if (!family.point(u, z, rho)) {
-            if (!out.z.empty()) break;  // one connected piece of curve: the first gap after it ends it
-            continue;
-        }
-        out.z.push_back(float(z));
-        out.rho.push_back(float(rho));
-        out.u.push_back(u);
-    }
-    return out.z.size() >= 2;
-}
-
-bool causticFoldPoint(const GlassSphere& s, const Light& light, double u, double& z, double& rho) {
-    const FoldFamily family(s, light);
-    return family.valid && family.point(u, z, rho);
-}
 
 }  // namespace vdbmarch

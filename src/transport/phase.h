@@ -6,8 +6,39 @@
 #pragma once
 
 #include "core/math.h"
+#include "core/sampling.h"
 
 namespace vdbmarch {
+
+// Henyey-Greenstein, the lobe every medium scatters by, written once here:
+// its value, the sampling of its cosine (pdf = value) and its Legendre
+// coefficients for the cache's projection (eq. 26). cosTheta is the cosine
+// between the incoming light's travel direction and the outgoing direction
+// (g > 0 scatters forward).
+inline float hgPhase(float cosTheta, float g) {
+    float denom = 1 + g * g - 2 * g * cosTheta;
+    return Inv4Pi * (1 - g * g) / (denom * std::sqrt(std::max(denom, 1e-12f)));
+}
+
+// Samples the cosine to the travel direction with pdf hgPhase(cos, g) over the
+// sphere (times the uniform azimuth). u in [0,1).
+inline float sampleHgCosTheta(float u, float g) {
+    if (std::fabs(g) < 1e-3f) return 1 - 2 * u;
+    float s = (1 - g * g) / (1 - g + 2 * g * u);
+    return clamp((1 + g * g - s * s) / (2 * g), -1.f, 1.f);
+}
+
+// HG in Legendre series: with the generating function
+//   1 / sqrt(1 - 2 g u + g^2) = sum_l g^l P_l(u)
+// and its derivative in g one finds
+//   (1 - g^2) / (1 - 2 g u + g^2)^{3/2} = sum_l (2l+1) g^l P_l(u),
+// so hgPhase(u) = sum_l (2l+1)/(4 pi) g^l P_l(u). With orthogonality,
+// Int P_k P_l du = 2/(2l+1) delta_kl, eq. 26 gives
+//   w'_l = 2 pi (2l+1)/(4 pi) g^l 2/(2l+1) = g^l.
+inline void hgLegendreWeights(int order, float g, float* out) {
+    out[0] = 1;
+    for (int l = 1; l <= order; ++l) out[l] = out[l - 1] * g;
+}
 
 constexpr int MaxMediaPerPoint = 8;
 

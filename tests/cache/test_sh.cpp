@@ -19,6 +19,7 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "support/support.h"
+#include "transport/phase.h"
 
 namespace vdbmarch {
 namespace {

@@ -10,6 +10,7 @@
 #include "core/blackbody.h"
 #include "core/sampling.h"
 #include "support/support.h"
+#include "transport/phase.h"
 
 namespace vdbmarch {
 namespace {

@@ -13,6 +13,7 @@
 #include "core/sampling.h"
 #include "illumination/illumination.h"
 #include "support/support.h"
+#include "transport/phase.h"
 
 namespace vdbmarch {
 namespace {

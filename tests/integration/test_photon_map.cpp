@@ -13,11 +13,12 @@
 
 #include "core/sampling.h"
 #include "estimators/estimator.h"
+#include "illumination/illumination.h"
 #include "photons/photon_map.h"
 #include "photons/photon_tracer.h"
-#include "illumination/illumination.h"
 #include "strategies/sphere_caustics.h"
 #include "support/support.h"
+#include "transport/phase.h"
 
 namespace vdbmarch {
 namespace {

@@ -16,6 +16,7 @@
 #include "core/sampling.h"
 #include "illumination/bake.h"
 #include "support/support.h"
+#include "transport/phase.h"
 
 namespace vdbmarch {
 namespace {
