@@ -16,8 +16,12 @@ command -v ccache >/dev/null && LAUNCHER="-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"
 export CCACHE_BASEDIR="$ROOT" CCACHE_NOHASHDIR=true
 # VDBMARCH_SANITIZE adds -fsanitize=address,undefined to every target; UB
 # reports must stop the test, not scroll by.
+# -O1 -g1 (line tables): the optimisation the AddressSanitizer documentation
+# recommends, symbolised stack traces, and 2.4x less compile time than
+# RelWithDebInfo's -O2 -g on the OpenVDB-heavy files (BENCHMARKS.md, "CI").
 cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo $LAUNCHER -DVDBMARCH_SANITIZE=ON \
-    -DVDBMARCH_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_FLAGS="-fno-sanitize-recover=undefined" >/dev/null
+    -DVDBMARCH_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_FLAGS="-fno-sanitize-recover=undefined" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" >/dev/null
 TARGETS="vdbmarch vdbmarch_unit_tests"
 case "$LABELS" in *stress*) TARGETS="$TARGETS vdbmarch_stress_tests" ;; esac
 case "$LABELS" in *accuracy*) TARGETS="$TARGETS vdbmarch_accuracy_tests" ;; esac

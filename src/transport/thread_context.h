@@ -15,7 +15,9 @@
 
 namespace vdbmarch {
 
-struct ThreadContextExtension {
+// Aligned to a cache line, and so padded to whole lines: the scratch of two
+// threads' contexts, written at every vertex, never shares a line.
+struct alignas(64) ThreadContextExtension {
     virtual ~ThreadContextExtension() = default;
 };
 
