@@ -54,7 +54,7 @@ public:
     // Towards lights near the segment (the guided marcher), and towards the
     // folds of caustics behind glass spheres that it crosses: the mixture
     //   P'(t) = (1 - a - b) P(t) + a sum_l c_l p_l(t) + b p_f(t),
-    // p_l the equiangular densities of `lights` (prepareLightDistances), c_l
+    // p_l the equiangular densities of `lights` (LightDistances::prepare), c_l
     // their odds, p_f the folds' density (caustic_folds.h), inverted at u:
     // [0, 1 - a - b) draws from P, then a light by its odds and its sampler,
     // then the folds. False when the drawn t lies in no step (nothing

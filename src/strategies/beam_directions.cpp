@@ -64,7 +64,7 @@ void axialRange(const BBox& hull, const Vec3& origin, const Vec3& axis, float& s
 }
 
 // A spot's cone, where its distance sampling may pay in the region
-// (light_distance.h's candidates).
+// (light_distances.h's candidates).
 bool spotBeam(const Scene& scene, const LightDistances& distances, const BBox& hull, size_t i, int region,
               BeamDirections::Beam& b) {
     const Light& light = scene.lights[i];

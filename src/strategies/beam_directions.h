@@ -5,7 +5,7 @@
 // In a thin haze lit by beams, most of the light a path can still find is
 // in the beams (and on the floor patches they light); a phase- or
 // cosine-sampled direction crosses one rarely, and the
-// distance samples towards the light (light_distance.h) only pay on the
+// distance samples towards the light (light_distances.h) only pay on the
 // segments that do. So with probability BeamShare a vertex draws a point
 // in a beam instead and goes towards it: along the beam's axis over the
 // axial range of the region's scattering media, in proportion to what each

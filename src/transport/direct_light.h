@@ -57,7 +57,7 @@ struct DirectLightOptions {
     // Leave point and spot lights out: photons carry their light here.
     bool skipPointLights = false;
     // One weight per scene light multiplying its sample (the share of
-    // distance sampling's MIS left to this vertex, light_distance.h); null:
+    // distance sampling's MIS left to this vertex, light_distances.h); null:
     // all 1. A light of weight 0 casts no shadow ray.
     const float* lightWeights = nullptr;
     // >= 0: sample that light alone (no environment, no background).

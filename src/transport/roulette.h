@@ -43,7 +43,7 @@ inline bool russianRoulette(Color& beta, Rng& rng, float threshold = RouletteThr
 
 // The same rule for a scalar weight: a light sample whose MIS weight is
 // below MisWeightRouletteThreshold casts its shadow ray with probability
-// w / threshold and then counts the threshold (light_distance.h).
+// w / threshold and then counts the threshold (light_distances.h).
 constexpr float MisWeightRouletteThreshold = 0.25f;
 inline bool russianRoulette(float& w, Rng& rng, float threshold) {
     Color c(w);
