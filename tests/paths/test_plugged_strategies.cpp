@@ -26,7 +26,7 @@ using test::sceneFromJson;
 // Half phase sampling, half uniform directions, at medium vertices.
 class UniformDirections final : public DirectionStrategy {
 public:
-    explicit UniformDirections(size_t slot) : mSlot(slot) {}
+    UniformDirections(const Scene&, size_t slot) : mSlot(slot) {}
     bool attach(ThreadContext& ctx, int, ScatterVertex& v, bool) const override {
         if (!v.phase) return false;
         Scratch& s = ctx.extensionAt<Scratch>(mSlot);
@@ -106,6 +106,21 @@ private:
     const size_t mSlot;
 };
 
+// Renders `scene` with its default strategies plus a Strategy(scene, slot);
+// `samples` is the plugged strategy's sample count.
+template <typename Strategy>
+RenderResult renderPlugged(const Scene& scene, long& samples) {
+    auto set = StrategySet::build(scene);
+    auto strategy = std::make_unique<Strategy>(scene, set->newSlot());
+    const Strategy& plugged = *strategy;
+    set->add(std::move(strategy));
+    RenderOptions options;
+    options.strategies = set;
+    RenderResult r = renderImage(scene, options);
+    samples = plugged.samples.load();
+    return r;
+}
+
 TEST(PluggedStrategies, AUniformDirectionMixtureKeepsTheFurnaceAtTheBackground) {
     for (const char* sigma : {"4", "[1, 4, 9]"}) {  // grey, then chromatic extinction
         auto scene = sceneFromJson(str(
@@ -113,14 +128,9 @@ TEST(PluggedStrategies, AUniformDirectionMixtureKeepsTheFurnaceAtTheBackground) 
             "media": [{"type": "homogeneous", "sigma_a": 0, "sigma_s": )", sigma, R"(, "g": 0.7,
                        "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}}],
             "background": [1, 1, 1], "render": {"method": "reference", "spp": 8, "max_depth": 100000, "seed": 4}})"));
-        auto set = StrategySet::build(*scene);
-        auto directions = std::make_unique<UniformDirections>(set->newSlot());
-        const UniformDirections& plugged = *directions;
-        set->add(std::move(directions));
-        RenderOptions options;
-        options.strategies = set;
-        const RenderResult r = renderImage(*scene, options);
-        EXPECT_GT(plugged.samples.load(), 1000) << "the loop never asked the plugged strategy";
+        long samples = 0;
+        const RenderResult r = renderPlugged<UniformDirections>(*scene, samples);
+        EXPECT_GT(samples, 1000) << "the loop never asked the plugged strategy";
         EXPECT_EQ(r.counters.nonFiniteSamples, 0u);
         for (int c = 0; c < 3; ++c) {
             const auto s = pixelStats(r.image, c);
@@ -140,14 +150,9 @@ TEST(PluggedStrategies, AUniformDistanceSamplerAgreesWithTrackingAlone) {
         "render": {"method": "reference", "spp": 32, "max_depth": 3, "seed": 9},
         "experiments": {"volume_sampling": "distance"}})");
     const RenderResult plain = renderImage(*scene);
-    auto set = StrategySet::build(*scene);
-    auto distances = std::make_unique<UniformDistances>(*scene, set->newSlot());
-    const UniformDistances& plugged = *distances;
-    set->add(std::move(distances));
-    RenderOptions options;
-    options.strategies = set;
-    const RenderResult r = renderImage(*scene, options);
-    EXPECT_GT(plugged.samples.load(), 1000) << "the loop never asked the plugged strategy";
+    long samples = 0;
+    const RenderResult r = renderPlugged<UniformDistances>(*scene, samples);
+    EXPECT_GT(samples, 1000) << "the loop never asked the plugged strategy";
     EXPECT_EQ(r.counters.nonFiniteSamples, 0u);
     test::expectPairedAgreement(plain.image, r.image, "uniform distances against tracking alone");
 }
