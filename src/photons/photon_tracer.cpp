@@ -196,10 +196,10 @@ PhotonTarget photonTarget(const Scene& scene) {
     if (t.unbounded) {
         // Fog fills all space: cover what the scene has that is finite.
         for (const Light& l : scene.lights) {
-            const LightDesc& d = l.desc();
-            if (d.type == LightDesc::Type::Point || d.type == LightDesc::Type::Spot || d.type == LightDesc::Type::Sphere)
-                finite.expand(d.position);
-            if (d.type == LightDesc::Type::CollimatedQuad) finite.expand(d.center);
+            Vec3 center;
+            float radius;
+            if (l.emittingBall(center, radius)) finite.expand(center);
+            if (const CollimatedQuad* quad = l.collimatedQuad()) finite.expand(quad->center);
         }
         finite.expand(scene.desc.camera.position);
         finite.expand(scene.desc.camera.lookAt);

@@ -129,7 +129,7 @@ bool sceneEmitsLight(const SceneDesc& desc) {
     for (const MediumDesc& m : desc.media)
         if (m.hasEmission) return true;
     for (const LightDesc& l : desc.lights)
-        if (l.type == LightDesc::Type::Sphere) return true;
+        if (!makeLight(l)->isDelta()) return true;  // an area light
     return false;
 }
 

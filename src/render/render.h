@@ -97,7 +97,7 @@ struct RenderResult {
 };
 
 // The scene emits light a camera ray can meet before any scattering: an
-// emissive medium or a sphere light (RenderOptions::keepEmitted).
+// emissive medium or an area light (RenderOptions::keepEmitted).
 bool sceneEmitsLight(const SceneDesc& desc);
 
 // Tile `index` of `count` of a width x height frame: horizontal bands of

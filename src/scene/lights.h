@@ -1,28 +1,24 @@
-// Light sources for next-event estimation. A sample gives the direction to
-// the light, the distance to it, and the incident quantity: irradiance (W/m^2
-// at the point, perpendicular to wi) for delta lights, radiance / pdf for area
-// lights; either way in-scattered radiance is sigma_s * phase * L * T.
+// Light sources: the interface the renderer asks of a light (Mitsuba 3's
+// Emitter, pbrt-v4's Light), one class per kind in scene/lights/. A sample
+// gives the direction to the light, the distance to it, and the incident
+// quantity: irradiance (W/m^2 at the point, perpendicular to wi) for delta
+// lights, radiance / pdf for area lights; either way in-scattered radiance
+// is sigma_s * phase * L * T.
+//
+// A new kind of light is a new subclass (and its entry in the parser and in
+// makeLight): next-event estimation, MIS, photon emission and scene set-up
+// only call the virtuals below; the strategies that exploit one kind's
+// geometry ask for it by spotCone(), sphere() or collimatedQuad().
 #pragma once
+
+#include <memory>
+#include <vector>
 
 #include "core/math.h"
 #include "parse/scene_desc.h"
+#include "scene/lights/light_emission.h"
 
 namespace vdbmarch {
-
-// A spot light's falloff, written once for next-event estimation and photon
-// emission: 1 inside the inner cone, a smoothstep to 0 at the cone's edge.
-// In t = 1 - cos of the angle to the spot axis, with omcCone = 1 - cosCone
-// and omcFalloff = 1 - cosFalloffStart (both exact in float), so that
-// hair-thin cones keep their shape. omcFalloff >= omcCone: hard edge.
-template <typename T>
-T spotFalloff(T t, T omcCone, T omcFalloff) {
-    if (t >= omcCone) return 0;
-    if (t > omcFalloff) {
-        T s = (omcCone - t) / (omcCone - omcFalloff);
-        return s * s * (3 - 2 * s);  // smoothstep
-    }
-    return 1;
-}
 
 struct LightSample {
     Vec3 wi;     // unit, from the shaded point towards the light
@@ -31,41 +27,121 @@ struct LightSample {
     float pdf = 0;  // solid-angle pdf of wi for area lights; 0 for delta lights
 };
 
+// A spot light's cone (Light::spotCone), with its falloff's cosines as
+// spotFalloff (scene/lights/spot_light.h) takes them.
+struct SpotCone {
+    Vec3 apex, axis;  // the light's position and unit direction
+    float coneDeg = 30, falloffDeg = 5;
+    float cosCone = -1, cosFalloffStart = -1;
+    float omcCone = 2, omcFalloffStart = 2;  // 1 - those cosines
+};
+
+// A sphere light's surface (Light::sphere).
+struct LightSphere {
+    Vec3 center;
+    float radius = 1;
+};
+
+// A collimated quad (Light::collimatedQuad): the parallelogram
+// center + a u + b v, |a|, |b| <= 1/2, shining along the unit `direction`.
+struct CollimatedQuad {
+    Vec3 center, u, v, direction;
+};
+
 class Light {
 public:
-    explicit Light(const LightDesc& d);
+    virtual ~Light() = default;
+    Light(const Light&) = delete;
+    Light& operator=(const Light&) = delete;
+
+    // --- Next-event estimation and MIS
     // False when the light cannot illuminate x (outside a spot cone, beside a
     // collimated quad, inside a sphere light).
-    bool sample(const Vec3& x, float u1, float u2, LightSample& s) const;
+    virtual bool sample(const Vec3& x, float u1, float u2, LightSample& s) const = 0;
     // The solid-angle density with which sample() at x draws a direction
-    // that hits the light: uniform over the cone a sphere light subtends,
-    // so the same for every such direction. 0 for delta lights and where
-    // sample() cannot draw (inside a sphere light). The path loops weigh a
-    // path's own light hits against next-event estimation by it (MIS).
-    float directionPdf(const Vec3& x) const;
-    bool isDelta() const { return mDesc.type != LightDesc::Type::Sphere; }
-    bool isSphere() const { return mDesc.type == LightDesc::Type::Sphere; }
+    // that hits the light. 0 for delta lights and where sample() cannot
+    // draw. The path loops weigh a path's own light hits against
+    // next-event estimation by it (MIS).
+    virtual float directionPdf(const Vec3& x) const { return 0; }
+    // A delta light: no path can hit it, only next-event estimation sees it.
+    virtual bool isDelta() const { return true; }
     // A point or spot light: its irradiance grows as 1/d^2 close to it, so
     // next-event estimation at scattering vertices around it has unbounded variance.
-    bool isPointLike() const { return mDesc.type == LightDesc::Type::Point || mDesc.type == LightDesc::Type::Spot; }
-    // The part [t0, t1] of the ray r (t >= 0) that the light can reach: a
-    // spot's cone (the hull of its two pieces when the cone is wider than a
-    // hemisphere), all of the ray for other lights. False when the ray never
-    // enters the light's reach. Distance sampling towards the light only
-    // draws points there.
-    bool reachInterval(const Ray& r, float& t0, float& t1) const;
-    // Sphere lights only: nearest hit in (tMin, tMax).
-    bool intersect(const Ray& r, float tMin, float tMax, float& t) const;
-    // Radiance leaving a sphere light's surface: power / (4 pi^2 r^2).
-    Color emittedRadiance() const { return mRadiance; }
+    virtual bool isPointLike() const { return false; }
+    // The part [t0, t1] of the ray r (t >= 0) that the light can reach (a
+    // spot's cone); false when the ray never enters it. Distance sampling
+    // towards the light only draws points there. All of the ray by default.
+    virtual bool reachInterval(const Ray& r, float& t0, float& t1) const {
+        t0 = 0;
+        t1 = Infinity;
+        return true;
+    }
+    // Lights a path can hit (not delta): nearest hit in (tMin, tMax).
+    virtual bool intersect(const Ray& r, float tMin, float tMax, float& t) const { return false; }
+    // Radiance leaving the light's surface towards a path that hits it.
+    virtual Color emittedRadiance() const { return Color(); }
+
+    // --- Photon emission
+    // Emission sampling towards `target`; null when nothing reaches it.
+    std::unique_ptr<const LightEmission> photonEmission(const PhotonTarget& target) const;
+
+    // --- Scene set-up
+    // Infinitely far (a directional light): outside every closed surface.
+    virtual bool atInfinity() const { return false; }
+    // The ball that holds the points the light emits from and its shadow
+    // rays end on, where the scene set-up tracks it: a point or spot light's
+    // position (radius 0), a sphere light's sphere. False elsewhere (the
+    // light may then be anywhere: a shadow ray from inside closed surfaces
+    // may reach it).
+    virtual bool emittingBall(Vec3& center, float& radius) const { return false; }
+
+    // --- One kind's geometry, for the strategies built on it (null for other kinds)
+    virtual const SpotCone* spotCone() const { return nullptr; }
+    virtual const LightSphere* sphere() const { return nullptr; }
+    virtual const CollimatedQuad* collimatedQuad() const { return nullptr; }
+
+    // The parameters the scene file gave.
     const LightDesc& desc() const { return mDesc; }
 
-private:
+protected:
+    explicit Light(const LightDesc& d) : mDesc(d) {}
+    // photonEmission before its common checks (an empty target, no power).
+    virtual std::unique_ptr<LightEmission> emissionTowards(const PhotonTarget& target) const = 0;
+
     LightDesc mDesc;
-    Color mRadiance;
-    float mCosCone = -1;                    // spot cone (reachInterval)
-    float mOmcCone = 2, mOmcFalloffStart = 2;  // 1 - the cone's and falloff start's cosines (spotFalloff)
-    Vec3 mQuadNormal, mDualU, mDualV;  // collimated quad plane and dual basis
+};
+
+// The light a description asks for.
+std::unique_ptr<Light> makeLight(const LightDesc& d);
+
+// The scene's lights, owned, indexed and iterated as `const Light&`.
+class LightList {
+public:
+    using Owned = std::vector<std::unique_ptr<Light>>;
+    class Iterator {
+    public:
+        explicit Iterator(Owned::const_iterator it) : mIt(it) {}
+        const Light& operator*() const { return **mIt; }
+        Iterator& operator++() {
+            ++mIt;
+            return *this;
+        }
+        bool operator!=(const Iterator& o) const { return mIt != o.mIt; }
+
+    private:
+        Owned::const_iterator mIt;
+    };
+
+    void add(std::unique_ptr<Light> light) { mLights.push_back(std::move(light)); }
+    size_t size() const { return mLights.size(); }
+    bool empty() const { return mLights.empty(); }
+    const Light& operator[](size_t i) const { return *mLights[i]; }
+    const Light& at(size_t i) const { return *mLights.at(i); }
+    Iterator begin() const { return Iterator(mLights.begin()); }
+    Iterator end() const { return Iterator(mLights.end()); }
+
+private:
+    Owned mLights;
 };
 
 }  // namespace vdbmarch

@@ -56,6 +56,15 @@ bool mayBeInside(const Scene& scene, const Vec3& p, const std::vector<int>& arou
     return false;
 }
 
+// Whether the ball (center, radius) may lie inside or cross one of the
+// closed surfaces `around` (radius 0: a point).
+bool ballMayBeInside(const Scene& scene, const Vec3& center, float radius, const std::vector<int>& around) {
+    bool near = mayBeInside(scene, center, around);
+    if (radius > 0)
+        for (int s : around) near = near || scene.surfaceSet->mayComeWithin(s, center, radius * 1.001f);
+    return near;
+}
+
 // The spheres of refracting glass, uniformly scaled, that next-event
 // estimation sees light through (strategies/sphere_caustics.h), empty or
 // holding a medium.
@@ -88,8 +97,10 @@ void findGlassSpheres(Scene& scene) {
         g.emptyInside = scene.regions[size_t(g.inside)].media.empty();
         for (size_t j = 0; j < scene.surfaces.size(); ++j)
             if (j != i && scene.surfaceSet->mayComeWithin(int(j), g.center, g.radius)) g.emptyInside = false;
-        for (const Light& l : scene.lights)
-            if (l.isSphere() && length(l.desc().position - g.center) < g.radius + l.desc().radius) g.emptyInside = false;
+        for (const Light& l : scene.lights) {
+            const LightSphere* ls = l.sphere();
+            if (ls && length(ls->center - g.center) < g.radius + ls->radius) g.emptyInside = false;
+        }
         scene.glassSpheres.push_back(g);
     }
 }
@@ -124,15 +135,16 @@ bool connectsDeltaLightCaustics(const Scene& scene) {
     for (const Light& l : scene.lights) {
         if (!l.isDelta()) continue;
         delta = true;
-        const LightDesc& d = l.desc();
+        const CollimatedQuad* quad = l.collimatedQuad();
         for (const GlassSphere& g : scene.glassSpheres) {
             if (l.isPointLike()) {
                 // Inside a sphere or outside all, off their surfaces (where
                 // the connections' roots would not be found).
-                if (!(std::fabs(length(d.position - g.center) - g.radius) > 1e-4f * g.radius)) return false;
-            } else if (d.type == LightDesc::Type::CollimatedQuad) {
+                if (!(std::fabs(length(l.desc().position - g.center) - g.radius) > 1e-4f * g.radius)) return false;
+            } else if (quad) {
                 // The quad outside every ball (its beam then enters from outside).
-                if (!(length(d.center - g.center) > g.radius + 0.5f * (length(d.u) + length(d.v)))) return false;
+                if (!(length(quad->center - g.center) > g.radius + 0.5f * (length(quad->u) + length(quad->v))))
+                    return false;
             }
         }
     }
@@ -162,24 +174,12 @@ void computeShadowReach(Scene& scene) {
         char* reach = &scene.shadowReach[r * (nLights + 1)];
         reach[nLights] = 0;  // the environment: outside every closed surface
         for (size_t i = 0; i < nLights; ++i) {
-            const LightDesc& l = scene.lights[i].desc();
-            switch (l.type) {
-                case LightDesc::Type::Directional:
-                    reach[i] = 0;
-                    break;
-                case LightDesc::Type::Point:
-                case LightDesc::Type::Spot:
-                    reach[i] = mayBeInside(scene, l.position, around);
-                    break;
-                case LightDesc::Type::Sphere: {
-                    bool near = mayBeInside(scene, l.position, around);
-                    for (int s : around) near = near || scene.surfaceSet->mayComeWithin(s, l.position, l.radius * 1.001f);
-                    reach[i] = near;
-                    break;
-                }
-                default:  // a collimated quad may cross the surfaces anywhere
-                    break;
-            }
+            const Light& l = scene.lights[i];
+            Vec3 center;
+            float radius;
+            if (l.atInfinity()) reach[i] = 0;
+            else if (l.emittingBall(center, radius)) reach[i] = ballMayBeInside(scene, center, radius, around);
+            // Elsewhere (a collimated quad) the light may cross the surfaces anywhere.
         }
     }
 }
@@ -193,10 +193,8 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     scene->environment = desc.environment.file.empty()
                              ? Environment(desc.background)
                              : Environment(desc.environment, str(desc.file, ": environment.file"));
-    for (const auto& l : desc.lights) {
-        scene->lights.emplace_back(l);
-        scene->hasSphereLights = scene->hasSphereLights || l.type == LightDesc::Type::Sphere;
-    }
+    for (const auto& l : desc.lights) scene->lights.add(makeLight(l));
+    for (const Light& l : scene->lights) scene->hasSphereLights = scene->hasSphereLights || l.sphere();
 
     // Media: a medium named as some surface's interior lives only there.
     std::vector<bool> isInterior(desc.media.size(), false);
@@ -276,12 +274,15 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
         scene->surfaceSet->addMesh(std::move(mesh), int(i), sd.smoothNormals);
     }
     scene->surfaceSet->commit();
-    for (const auto& l : desc.lights) {
-        if (l.type == LightDesc::Type::Sphere) {
-            bounds.expand(l.position - Vec3(l.radius));
-            bounds.expand(l.position + Vec3(l.radius));
-        } else if (l.type == LightDesc::Type::Point || l.type == LightDesc::Type::Spot) {
-            bounds.expand(l.position);
+    for (const Light& l : scene->lights) {
+        Vec3 center;
+        float radius;
+        if (!l.emittingBall(center, radius)) continue;
+        if (radius > 0) {
+            bounds.expand(center - Vec3(radius));
+            bounds.expand(center + Vec3(radius));
+        } else {
+            bounds.expand(center);
         }
     }
     bounds.expand(desc.camera.position);

@@ -80,7 +80,7 @@ public:
 
     SceneDesc desc;
     std::unique_ptr<Camera> camera;
-    std::vector<Light> lights;
+    LightList lights;
     std::vector<std::unique_ptr<Medium>> media;
     std::vector<Region> regions;
     std::vector<SurfaceInfo> surfaces;

@@ -68,13 +68,12 @@ void axialRange(const BBox& hull, const Vec3& origin, const Vec3& axis, float& s
 bool spotBeam(const Scene& scene, const LightDistances& distances, const BBox& hull, size_t i, int region,
               BeamDirections::Beam& b) {
     const Light& light = scene.lights[i];
-    if (light.desc().type != LightDesc::Type::Spot || !distances.regionHasCandidates(region, false) ||
-        !distances.candidate(region, int(i)))
-        return false;
+    const SpotCone* spot = light.spotCone();
+    if (!spot || !distances.regionHasCandidates(region, false) || !distances.candidate(region, int(i))) return false;
     b.light = int(i);
-    b.apex = light.desc().position;
-    b.axis = normalize(light.desc().direction);
-    const double cone = double(light.desc().coneDeg) * (PiD / 180);
+    b.apex = spot->apex;
+    b.axis = normalize(spot->axis);
+    const double cone = double(spot->coneDeg) * (PiD / 180);
     if (!(cone > 0 && cone < 0.5 * PiD * 0.99)) return false;
     b.tanCone = float(std::tan(cone));
     const float cosCone = float(std::cos(cone));
@@ -95,30 +94,32 @@ bool spotBeam(const Scene& scene, const LightDistances& distances, const BBox& h
 // perpendicular to the axis is the quad seen along the beam, of constant
 // area, so the power per unit length is the irradiance times that area.
 bool prismBeam(const Scene& scene, const BBox& hull, size_t i, int region, BeamDirections::Beam& b) {
-    const LightDesc& d = scene.lights[i].desc();
-    if (d.type != LightDesc::Type::CollimatedQuad || !openToRegion(scene, d.center, region)) return false;
+    const Light& light = scene.lights[i];
+    const CollimatedQuad* quad = light.collimatedQuad();
+    if (!quad || !openToRegion(scene, quad->center, region)) return false;
+    const CollimatedQuad& q = *quad;
     b.light = int(i);
     b.prism = true;
-    b.apex = d.center;
-    b.axis = normalize(d.direction);
-    b.u = d.u;
-    b.v = d.v;
-    b.uAxial = dot(d.u, b.axis);
-    b.vAxial = dot(d.v, b.axis);
-    const Vec3 n = cross(d.u, d.v);
+    b.apex = q.center;
+    b.axis = normalize(q.direction);
+    b.u = q.u;
+    b.v = q.v;
+    b.uAxial = dot(q.u, b.axis);
+    b.vAxial = dot(q.v, b.axis);
+    const Vec3 n = cross(q.u, q.v);
     const float n2 = lengthSquared(n), dn = dot(b.axis, n);
     b.area = std::fabs(dn);
     if (!(n2 > 0) || !(b.area > 1e-6f * n2)) return false;  // a beam along the quad's plane
     // A point's quad coordinates along the beam: its projection along the
     // axis onto the quad's plane, in the dual basis of u and v.
-    const Vec3 dualU = cross(d.v, n) / n2, dualV = cross(n, d.u) / n2;
+    const Vec3 dualU = cross(q.v, n) / n2, dualV = cross(n, q.u) / n2;
     b.dualA = dualU - n * (dot(b.axis, dualU) / dn);
     b.dualB = dualV - n * (dot(b.axis, dualV) / dn);
     float s0, s1;
     axialRange(hull, b.apex, b.axis, s0, s1);
     b.s0 = std::max(s0, 0.5f * (std::fabs(b.uAxial) + std::fabs(b.vAxial)));
     b.s1 = s1;
-    b.power = std::max(average(d.irradiance), 0.f) * b.area;
+    b.power = std::max(average(light.desc().irradiance), 0.f) * b.area;
     return b.s1 > b.s0 && b.power > 0;
 }
 

@@ -180,12 +180,12 @@ CausticFolds::CausticFolds(const Scene& scene, size_t slot) : mScene(scene), mSl
             const Light& l = scene.lights[li];
             if (!l.isDelta()) continue;
             // A spot whose cone misses the ball casts no caustic through it.
-            if (l.desc().type == LightDesc::Type::Spot) {
-                const Vec3 to = s.center - l.desc().position;
+            if (const SpotCone* cone = l.spotCone()) {
+                const Vec3 to = s.center - cone->apex;
                 const float dist = length(to);
                 if (!(dist > s.radius)) continue;
-                const float reach = radians(l.desc().coneDeg) + std::asin(s.radius / dist);
-                if (!(dot(to / dist, normalize(l.desc().direction)) > std::cos(std::min(reach, Pi)))) continue;
+                const float reach = radians(cone->coneDeg) + std::asin(s.radius / dist);
+                if (!(dot(to / dist, normalize(cone->axis)) > std::cos(std::min(reach, Pi)))) continue;
             }
             Surface f;
             if (!causticFold(s, l, f.fold)) continue;

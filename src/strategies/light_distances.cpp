@@ -11,14 +11,15 @@ namespace {
 
 // A ray through a point light's very position: keep the density finite.
 float minDistance(const Scene& scene, const Light& light) {
-    return light.isSphere() ? light.desc().radius : 1e-6f * scene.sceneScale;
+    const LightSphere* sphere = light.sphere();
+    return sphere ? sphere->radius : 1e-6f * scene.sceneScale;
 }
 
 // Distance sampling pays where its gain over tracking exceeds this (see
 // prepare). A sphere light's radiance is bounded (its solid angle, not
 // 1/r^2, grows near it) and next-event estimation already meets the path's
 // hits by MIS there: it needs a much larger gain (docs/method.md).
-float gainThreshold(const Light& light) { return light.isSphere() ? 64.f : 2.f; }
+float gainThreshold(const Light& light) { return light.sphere() ? 64.f : 2.f; }
 
 }  // namespace
 
@@ -37,11 +38,11 @@ LightDistances::LightDistances(const Scene& scene, size_t slot)
         if (hull.empty()) continue;
         for (size_t i = 0; i < mLights; ++i) {
             const Light& light = scene.lights[i];
-            if (!(light.isPointLike() || light.isSphere())) continue;
+            if (!(light.isPointLike() || light.sphere())) continue;
             const Vec3& c = light.desc().position;
             if (!openToRegion(scene, c, int(r))) continue;
             bool mayPay = true;
-            if (light.desc().type != LightDesc::Type::Spot && hull.isFinite()) {
+            if (!light.spotCone() && hull.isFinite()) {
                 const Vec3 nearest = min(max(c, hull.lo), hull.hi);
                 const Vec3 farthest = max(max(c - hull.lo, hull.lo - c), max(c - hull.hi, hull.hi - c));
                 const float rMin = std::max(length(c - nearest), minDistance(scene, light));
@@ -99,7 +100,7 @@ bool LightDistances::prepare(ThreadContext& ctx, const PathSegment& seg) const {
         double sum = 0;
         for (LightDistance& ld : lights) {
             const Light& light = mScene.lights[size_t(ld.light)];
-            const Color intensity = light.isSphere() ? light.desc().power * (1 / (4 * Pi)) : light.desc().intensity;
+            const Color intensity = light.sphere() ? light.desc().power * (1 / (4 * Pi)) : light.desc().intensity;
             ld.choice = std::max(average(intensity), 0.f) * ld.sampler.inverseSquareIntegral();
             sum += double(ld.choice);
         }

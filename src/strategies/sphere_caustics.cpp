@@ -60,7 +60,8 @@ double ballConePdf(const GlassSphere& s, const Vec3& x, float* cosMax = nullptr)
 // The connections' density over directions at x of the path of the pattern
 // along w that reaches y on light l: 0 when the solver from (x, y) finds no
 // root matching w.
-double connectionPdf(const GlassSphere& s, int pattern, const Light& l, const Vec3& x, const Vec3& w, const Vec3& y) {
+double connectionPdf(const GlassSphere& s, int pattern, const LightSphere& l, const Vec3& x, const Vec3& w,
+                     const Vec3& y) {
     SphereConnection roots[MaxSphereConnections];
     const int n = connect(s, pattern, x, y, roots);
     int best = -1;
@@ -74,9 +75,9 @@ double connectionPdf(const GlassSphere& s, int pattern, const Light& l, const Ve
     }
     if (best < 0) return 0;
     const SphereConnection& cn = roots[best];
-    const double cosY = -double(dot(cn.wo, normalize(y - l.desc().position)));
+    const double cosY = -double(dot(cn.wo, normalize(y - l.center)));
     if (!(cosY > 0) || !(cn.spreading > 0)) return 0;
-    const double rl = l.desc().radius;
+    const double rl = l.radius;
     return cn.spreading / (4 * double(Pi) * rl * rl * cosY);
 }
 
@@ -150,9 +151,10 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
                 }
                 continue;
             }
-            if (!lights.areaLights || !light.isSphere()) continue;
-            const Vec3 lc = light.desc().position;
-            const float rl = light.desc().radius;
+            const LightSphere* sphere = light.sphere();
+            if (!lights.areaLights || !sphere) continue;
+            const Vec3 lc = sphere->center;
+            const float rl = sphere->radius;
             // 1. Connections: y uniform on the light's surface.
             const Vec3 ny = sampleUniformSphere(rng.uniform(), rng.uniform());
             const Vec3 y = lc + ny * rl;
@@ -189,7 +191,7 @@ Color sphereCausticLight(ThreadContext& ctx, int region, const ScatterVertex& v,
             const Vec3 yHit = cn.p2 + cn.wo * tLight;
             const Color T = throughBall(cn, &yHit, 0.f);
             if (isBlack(T)) continue;
-            const double pm = connectionPdf(s, 2, light, v.p, cn.wi, yHit);
+            const double pm = connectionPdf(s, 2, *sphere, v.p, cn.wi, yHit);
             const double pu = lights.pathFollows ? double(v.pdf(cn.wi)) * double(cn.transmission) : 0.0;
             L += f * light.emittedRadiance() * T * float(double(cn.transmission) * power3(pc, pm, pu) / pc);
         }
@@ -201,12 +203,13 @@ float sphereCausticPathWeight(const Scene& scene, int sphere, int refractions, i
                               float pathPdf, const Vec3& y) {
     const GlassSphere& s = scene.glassSpheres[size_t(sphere)];
     const Light& l = scene.lights[size_t(light)];
-    if (!l.isSphere() || connectionPattern(s, l, x) != refractions) return 1;
+    const LightSphere* lightSphere = l.sphere();
+    if (!lightSphere || connectionPattern(s, l, x) != refractions) return 1;
     const Vec3 wn = normalize(w);
     SphereConnection traced;
     if (!(refractions == 2 ? traceThroughSphere(s, x, wn, traced) : traceAcrossSphere(s, x, wn, traced))) return 1;
     const double pu = double(pathPdf) * double(traced.transmission);
-    return float(power3(pu, connectionPdf(s, refractions, l, x, wn, y), refractions == 2 ? ballConePdf(s, x) : 0.0));
+    return float(power3(pu, connectionPdf(s, refractions, *lightSphere, x, wn, y), refractions == 2 ? ballConePdf(s, x) : 0.0));
 }
 
 float SphereCaustics::pathHitWeight(const SpecularChain& chain, int light, const Vec3& x, const Vec3& w, float pathPdf,

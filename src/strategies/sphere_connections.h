@@ -70,10 +70,12 @@ constexpr double RootMatchCos = 1 - 1e-6;
 // The glass sphere a sphere light can be reached through: outside it, or
 // (one refraction) inside it.
 inline bool lightOutside(const GlassSphere& s, const Light& l) {
-    return l.isSphere() && length(l.desc().position - s.center) > s.radius + l.desc().radius;
+    const LightSphere* ls = l.sphere();
+    return ls && length(ls->center - s.center) > s.radius + ls->radius;
 }
 inline bool lightInside(const GlassSphere& s, const Light& l) {
-    return l.isSphere() && length(l.desc().position - s.center) + l.desc().radius < s.radius;
+    const LightSphere* ls = l.sphere();
+    return ls && length(ls->center - s.center) + ls->radius < s.radius;
 }
 
 // The fold (scene.h's CausticFold) of light `light` through sphere s,

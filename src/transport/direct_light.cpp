@@ -71,7 +71,7 @@ Color directLight(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& r
         if (isBlack(f)) continue;
         const float survivor = phaseRouletteWeight(rouletteLevel, f, rng);
         if (!(survivor > 0)) continue;
-        const float w = o.misWithPathHits && light.isSphere() ? powerHeuristic(ls.pdf, v.pdf(ls.wi)) : 1.f;
+        const float w = o.misWithPathHits && !light.isDelta() ? powerHeuristic(ls.pdf, v.pdf(ls.wi)) : 1.f;
         L += f * ls.L * shadowTransmittance(ctx, region, origin, ls.wi, ls.dist, rng, o.transmittance) *
              (w * lightWeight * survivor);
     }

@@ -46,8 +46,8 @@ TEST(LightDistance, SingleScatteringFromPointAndSpotMatchesQuadrature) {
         "look_at": [0.475, 0.475, 0], "up": [0, 1, 0], "width_world": 0.5, "resolution": [32, 32]})";
 
     // Quadrature of the view-square mean, whole and by halves in x.
-    const Light point(pointLight(Vec3(0.85f, 0.475f, 0.1f), Color(0.5f)));
-    const Light spot(spotLight(Vec3(0.475f, -0.3f, -0.2f), normalize(Vec3(0, 1, 0.15f)), 10, 3, Color(2)));
+    const auto point = makeLight(pointLight(Vec3(0.85f, 0.475f, 0.1f), Color(0.5f)));
+    const auto spot = makeLight(spotLight(Vec3(0.475f, -0.3f, -0.2f), normalize(Vec3(0, 1, 0.15f)), 10, 3, Color(2)));
     const Vec3 d(0, 0, -1);
     const int nxy = 160, nz = 800;
     double half[2] = {0, 0};
@@ -59,7 +59,7 @@ TEST(LightDistance, SingleScatteringFromPointAndSpotMatchesQuadrature) {
                 const double z = 0.5 - (iz + 0.5) / nz;
                 const Vec3 p{float(x), float(y), float(z)};
                 double s = 0;
-                for (const Light* l : {&point, &spot}) {
+                for (const Light* l : {point.get(), spot.get()}) {
                     LightSample ls;
                     if (!l->sample(p, 0, 0, ls)) continue;
                     s += double(hgPhase(dot(ls.wi, d), g)) * ls.L.x * std::exp(-sigmaT * ls.dist);

@@ -147,11 +147,11 @@ void expectPowerNear(const Color& got, const Color& want, double rel = 1e-5) {
 
 TEST(PhotonEmissionPoint, InsideTargetShootsWholeSphere) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
-    Light light(pointLight({0.2f, 0.3f, -0.1f}, {2, 1, 0.5f}));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(pointLight({0.2f, 0.3f, -0.1f}, {2, 1, 0.5f}));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     expectPowerNear(e.power(), Color(2, 1, 0.5f) * float(4 * PiD));
 
-    auto discs = deltaDiscs(light,
+    auto discs = deltaDiscs(*light,
                             {{{0.9f, 0.3f, -0.1f}, {1, 0, 0}},
                              {{-0.5f, -0.6f, 0.7f}, {1, 1, 0}},
                              {{0.2f, 0.9f, 0.5f}, {0, 0, 1}}},
@@ -162,13 +162,13 @@ TEST(PhotonEmissionPoint, InsideTargetShootsWholeSphere) {
 TEST(PhotonEmissionPoint, OutsideTargetShootsConeAtItsBoundingSphere) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
     Vec3 p(4, 1.5f, -0.5f);
-    Light light(pointLight(p, {3, 2, 1}));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(pointLight(p, {3, 2, 1}));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     double d = length(p), sinA = targetRadius(target) / d;
     double solidAngle = 2 * PiD * (1 - std::sqrt(1 - sinA * sinA));
     expectPowerNear(e.power(), Color(3, 2, 1) * float(solidAngle), 1e-4);
 
-    auto discs = deltaDiscs(light,
+    auto discs = deltaDiscs(*light,
                             {{{0.9f, 0.9f, -0.9f}, {1, 0, 0}},
                              {{-0.8f, 0.2f, 0.6f}, {1, -1, 2}},
                              {{0, 0, 0}, {0, 1, 0}}},
@@ -179,12 +179,12 @@ TEST(PhotonEmissionPoint, OutsideTargetShootsConeAtItsBoundingSphere) {
 // A tiny target cone (distant light) keeps its spread despite float cosines.
 TEST(PhotonEmissionPoint, DistantLightTinyCone) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
-    Light light(pointLight({3000, 4000, 0}, {1, 1, 1}));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(pointLight({3000, 4000, 0}, {1, 1, 1}));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     double sin2 = std::pow(targetRadius(target) / 5000, 2);
     expectPowerNear(e.power(), Color(float(2 * PiD * sin2 / (1 + std::sqrt(1 - sin2)))), 1e-4);
 
-    auto discs = deltaDiscs(light, {{{0, 0, 0}, {0.6f, 0.8f, 0}}, {{0.5f, -0.5f, 0.5f}, {0, 1, 0}}}, 0.3);
+    auto discs = deltaDiscs(*light, {{{0, 0, 0}, {0.6f, 0.8f, 0}}, {{0.5f, -0.5f, 0.5f}, {0, 1, 0}}}, 0.3);
     Shot s = shoot(e, discs, 200000, 3);
     expectIrradiance(s, discs);
 }
@@ -192,22 +192,22 @@ TEST(PhotonEmissionPoint, DistantLightTinyCone) {
 TEST(PhotonEmissionSpot, NarrowSpotInsideTargetCone) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
     LightDesc desc = spotLight({0, 3, 0}, {0, -1, 0}, 20, 8, {5, 4, 3});
-    Light light(desc);
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(desc);
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     // Closed form: the smoothstep averages 1/2 over the falloff band.
     double cc = std::cos(double(radians(20))), cf = std::cos(double(radians(12)));
     double integral = 2 * PiD * ((1 - cf) + 0.5 * (cf - cc));
     expectPowerNear(e.power(), Color(5, 4, 3) * float(integral), 1e-5);
 
     // Discs on axis, in the falloff band (12..20 degrees) and outside the cone.
-    auto discs = deltaDiscs(light,
+    auto discs = deltaDiscs(*light,
                             {{{0, 0, 0}, {0, 1, 0}},
                              {{0.8f, 0, 0}, {0, 1, 0}},
                              {{0, -0.2f, 0.9f}, {0.3f, 1, -0.4f}},
                              {{0.9f, 0.5f, -0.9f}, {0, 1, 0}}},
                             0.03);
     ASSERT_GT(discs[1].expected, 0);
-    ASSERT_LT(discs[1].expected, deltaIrradiance(light, {0, 0, 0}, {0, 1, 0}));  // really in the falloff
+    ASSERT_LT(discs[1].expected, deltaIrradiance(*light, {0, 0, 0}, {0, 1, 0}));  // really in the falloff
     ASSERT_EQ(discs[3].expected, 0);
     expectIrradianceAndPower(e, discs, 3000000, 4);
 }
@@ -216,9 +216,9 @@ TEST(PhotonEmissionSpot, NarrowSpotInsideTargetCone) {
 // the falloff weights the photons.
 TEST(PhotonEmissionSpot, WideSpotSamplesTargetCone) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
-    Light light(spotLight({0, 10, 0}, {0.3f, -1, 0}, 30, 20, {5, 4, 3}));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
-    auto discs = deltaDiscs(light,
+    const auto light = makeLight(spotLight({0, 10, 0}, {0.3f, -1, 0}, 30, 20, {5, 4, 3}));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
+    auto discs = deltaDiscs(*light,
                             {{{0.9f, 0, 0}, {0, 1, 0}},
                              {{0, 0.5f, 0}, {0, 1, 0}},
                              {{-0.8f, -0.5f, 0.3f}, {1, 1, 1}}},
@@ -246,8 +246,8 @@ TEST(PhotonEmissionSpot, PartialOverlapPowerIsMean) {
     int seed = 10;
     for (const Case& c : cases) {
         SCOPED_TRACE(::testing::Message() << "cone " << c.cone << " falloff " << c.falloff);
-        Light light(spotLight(c.position, c.direction, c.cone, c.falloff, {1, 2, 3}));
-        PhotonEmitter e = PhotonEmitter::forLight(light, target);
+        const auto light = makeLight(spotLight(c.position, c.direction, c.cone, c.falloff, {1, 2, 3}));
+        PhotonEmitter e = PhotonEmitter::forLight(*light, target);
         ASSERT_GT(e.power().x, 0);
         Shot s = shoot(e, {}, 1000000, seed++);
         EXPECT_EQ(s.badPhotons, 0);
@@ -259,9 +259,9 @@ TEST(PhotonEmissionSpot, PartialOverlapPowerIsMean) {
 // still deliver the right irradiance.
 TEST(PhotonEmissionSpot, ClippedSpotIrradiance) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
-    Light light(spotLight({0, 3, 0}, {0.6f, -1, 0}, 15, 5, {5, 4, 3}));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
-    auto discs = deltaDiscs(light, {{{0.9f, 1.5f, 0}, {0, 1, 0}}, {{0.8f, 0.9f, 0.2f}, {1, 0, 0}}}, 0.03);
+    const auto light = makeLight(spotLight({0, 3, 0}, {0.6f, -1, 0}, 15, 5, {5, 4, 3}));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
+    auto discs = deltaDiscs(*light, {{{0.9f, 1.5f, 0}, {0, 1, 0}}, {{0.8f, 0.9f, 0.2f}, {1, 0, 0}}}, 0.03);
     for (const TestDisc& d : discs) ASSERT_GT(d.expected, 0);
     Shot s = shoot(e, discs, 2000000, 20);
     expectIrradiance(s, discs);
@@ -271,8 +271,8 @@ TEST(PhotonEmissionSpot, ClippedSpotIrradiance) {
 // the target cone's solid angle (checks the overlap quadrature).
 TEST(PhotonEmissionSpot, TargetInsideFlatCoreIsExact) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
-    Light light(spotLight({0, 20, 0}, {0.05f, -1, 0}, 40, 10, {1, 2, 3}));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(spotLight({0, 20, 0}, {0.05f, -1, 0}, 40, 10, {1, 2, 3}));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     double sin2 = std::pow(targetRadius(target) / 20, 2);
     double solidAngle = 2 * PiD * sin2 / (1 + std::sqrt(1 - sin2));
     expectPowerNear(e.power(), Color(1, 2, 3) * float(solidAngle), 1e-5);
@@ -281,13 +281,13 @@ TEST(PhotonEmissionSpot, TargetInsideFlatCoreIsExact) {
 TEST(PhotonEmissionDirectional, DiscCoversTarget) {
     PhotonTarget target = boundedTarget({-1, -1, 0}, {2, 1, 1});
     Color irradiance(3, 2, 1);
-    Light light(directionalLight({1, -2, 0.5f}, irradiance));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(directionalLight({1, -2, 0.5f}, irradiance));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     double r = targetRadius(target);
     expectPowerNear(e.power(), irradiance * float(PiD * r * r));
 
     // Uniform field: a larger disc has no bias.
-    auto discs = deltaDiscs(light,
+    auto discs = deltaDiscs(*light,
                             {{{0, 0, 0.5f}, {-1, 2, -0.5f}},
                              {{1.7f, 0.7f, 0.2f}, {0, 1, 0}},
                              {{-0.7f, -0.7f, 0.8f}, {1, 0, 1}}},
@@ -307,8 +307,8 @@ TEST(PhotonEmissionCollimatedQuad, IrradianceInsideAndOutsideBeam) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
     Vec3 c(0, 3, 0), u(1.2f, 0, 0.3f), v(0.2f, 0.1f, 0.9f), dir = normalize(Vec3(0.2f, -1, 0.1f));
     Color irradiance(2, 1, 4);
-    Light light(quadLight(c, u, v, dir, irradiance));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(quadLight(c, u, v, dir, irradiance));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     // Flux through the quad: E times its area seen along the beam.
     expectPowerNear(e.power(), irradiance * std::fabs(dot(cross(u, v), dir)));
 
@@ -318,7 +318,7 @@ TEST(PhotonEmissionCollimatedQuad, IrradianceInsideAndOutsideBeam) {
         return h + dir * (h.y / -dir.y);
     };
     const double radius = 0.08;
-    auto discs = deltaDiscs(light,
+    auto discs = deltaDiscs(*light,
                             {{inBeam(0, 0), -dir},
                              {inBeam(0.2f, -0.15f), {1, 1, 0}},
                              {inBeam(-0.2f, 0.25f), {0, 0, 1}},
@@ -331,7 +331,7 @@ TEST(PhotonEmissionCollimatedQuad, IrradianceInsideAndOutsideBeam) {
         for (int k = 0; k < 16; ++k) {
             float phi = 2 * Pi * k / 16;
             Vec3 rim = d.x + (s * std::cos(phi) + t * std::sin(phi)) * float(radius);
-            ASSERT_EQ(deltaIrradiance(light, rim, d.n) > 0, d.expected > 0);
+            ASSERT_EQ(deltaIrradiance(*light, rim, d.n) > 0, d.expected > 0);
         }
     }
     ASSERT_EQ(discs[3].expected, 0);
@@ -341,19 +341,19 @@ TEST(PhotonEmissionCollimatedQuad, IrradianceInsideAndOutsideBeam) {
 TEST(PhotonEmissionCollimatedQuad, BeamMissingTargetHasNoPower) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
     // Beside the box, pointing past it.
-    Light beside(quadLight({3, 3, 0}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, {1, 1, 1}));
-    EXPECT_TRUE(isBlack(PhotonEmitter::forLight(beside, target).power()));
+    const auto beside = makeLight(quadLight({3, 3, 0}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, {1, 1, 1}));
+    EXPECT_TRUE(isBlack(PhotonEmitter::forLight(*beside, target).power()));
     // Downstream of the box, pointing away from it.
-    Light away(quadLight({0, 3, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 1, 1}));
-    EXPECT_TRUE(isBlack(PhotonEmitter::forLight(away, target).power()));
+    const auto away = makeLight(quadLight({0, 3, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 1, 1}));
+    EXPECT_TRUE(isBlack(PhotonEmitter::forLight(*away, target).power()));
     // Passing diagonally 0.17 beside a vertical edge of the box: the box's
     // own axes do not separate it, the beam's side face does.
-    Light diagonal(quadLight({2.2f, 0.2f, 0}, {0, 0, 1}, {0.15f, 0.15f, 0}, {-1, 1, 0}, {1, 1, 1}));
-    EXPECT_TRUE(isBlack(PhotonEmitter::forLight(diagonal, target).power()));
+    const auto diagonal = makeLight(quadLight({2.2f, 0.2f, 0}, {0, 0, 1}, {0.15f, 0.15f, 0}, {-1, 1, 0}, {1, 1, 1}));
+    EXPECT_TRUE(isBlack(PhotonEmitter::forLight(*diagonal, target).power()));
     // Unbounded target: nothing is culled.
     PhotonTarget everywhere = target;
     everywhere.unbounded = true;
-    EXPECT_FALSE(isBlack(PhotonEmitter::forLight(beside, everywhere).power()));
+    EXPECT_FALSE(isBlack(PhotonEmitter::forLight(*beside, everywhere).power()));
 }
 
 // The beam test is conservative: a quad it culls never sends a photon into the box.
@@ -365,15 +365,15 @@ TEST(PhotonEmissionCollimatedQuad, CullingIsConservative) {
     int culled = 0, kept = 0;
     for (int config = 0; config < 400; ++config) {
         Vec3 dir = sampleUniformSphere(rng.uniform(), rng.uniform());
-        Light light(quadLight(randomVec(3), randomVec(1.5f), randomVec(1.5f), dir, {1, 1, 1}));
-        PhotonEmitter e = PhotonEmitter::forLight(light, target);
+        const auto light = makeLight(quadLight(randomVec(3), randomVec(1.5f), randomVec(1.5f), dir, {1, 1, 1}));
+        PhotonEmitter e = PhotonEmitter::forLight(*light, target);
         if (!isBlack(e.power())) {
             ++kept;
             continue;
         }
         ++culled;
         // Shoot the same beam from an unbounded target's emitter.
-        PhotonEmitter all = PhotonEmitter::forLight(light, {target.bounds, true});
+        PhotonEmitter all = PhotonEmitter::forLight(*light, {target.bounds, true});
         for (int i = 0; i < 2000; ++i) {
             float u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
             EmittedPhoton p;
@@ -391,12 +391,12 @@ TEST(PhotonEmissionSphere, LambertianSurfaceIrradiance) {
     Vec3 center(0.3f, 0.2f, -0.1f);
     float r = 0.4f;
     Color power(10, 5, 2);
-    Light light(sphereLight(center, r, power));
-    PhotonEmitter e = PhotonEmitter::forLight(light, target);
+    const auto light = makeLight(sphereLight(center, r, power));
+    PhotonEmitter e = PhotonEmitter::forLight(*light, target);
     expectPowerNear(e.power(), power, 0);
 
     // Discs facing the sphere's centre: E = pi Lrad sin^2(alpha).
-    double lrad = light.emittedRadiance().x;
+    double lrad = light->emittedRadiance().x;
     std::vector<TestDisc> discs;
     for (Vec3 x : {Vec3(1.8f, 0.2f, -0.1f), Vec3(-0.7f, -1.0f, 1.1f)}) {
         Vec3 n = normalize(center - x);
@@ -410,7 +410,7 @@ TEST(PhotonEmissionSphere, LambertianSurfaceIrradiance) {
     Rng rng(60);
     for (long i = 0; i < m; ++i) {
         LightSample ls;
-        if (light.sample(x, rng.uniform(), rng.uniform(), ls)) nee.add(ls.L.x * std::max(0.f, dot(ls.wi, n)));
+        if (light->sample(x, rng.uniform(), rng.uniform(), ls)) nee.add(ls.L.x * std::max(0.f, dot(ls.wi, n)));
     }
     discs.push_back({x, n, 0.1, nee.mean(m), true});
 
@@ -471,12 +471,12 @@ TEST(PhotonEmissionEnvironment, MapDeliversItsIrradiance) {
 TEST(PhotonEmissionTarget, UnboundedTarget) {
     PhotonTarget target{makeBox({-1, -1, -1}, {1, 1, 1}), true};
     double r = targetRadius(target);
-    Light sun(directionalLight({0, -1, 0}, {1, 1, 1}));
-    expectPowerNear(PhotonEmitter::forLight(sun, target).power(), Color(float(PiD * r * r)));
-    Light point(pointLight({10, 0, 0}, {1, 1, 1}));
-    expectPowerNear(PhotonEmitter::forLight(point, target).power(), Color(float(4 * PiD)));
-    Light spot(spotLight({10, 0, 0}, {1, 0, 0}, 30, 0, {1, 1, 1}));  // pointing away, still counts
-    expectPowerNear(PhotonEmitter::forLight(spot, target).power(),
+    const auto sun = makeLight(directionalLight({0, -1, 0}, {1, 1, 1}));
+    expectPowerNear(PhotonEmitter::forLight(*sun, target).power(), Color(float(PiD * r * r)));
+    const auto point = makeLight(pointLight({10, 0, 0}, {1, 1, 1}));
+    expectPowerNear(PhotonEmitter::forLight(*point, target).power(), Color(float(4 * PiD)));
+    const auto spot = makeLight(spotLight({10, 0, 0}, {1, 0, 0}, 30, 0, {1, 1, 1}));  // pointing away, still counts
+    expectPowerNear(PhotonEmitter::forLight(*spot, target).power(),
                     Color(float(2 * PiD * (1 - std::cos(double(radians(30)))))), 1e-4);
 }
 
@@ -497,40 +497,40 @@ void expectNothingEmitted(const PhotonEmitter& e) {
 
 TEST(PhotonEmissionZero, SpotPointingAwayFromTarget) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
-    expectNothingEmitted(PhotonEmitter::forLight(Light(spotLight({0, 3, 0}, {0, 1, 0}, 30, 5, {1, 1, 1})), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(spotLight({0, 3, 0}, {0, 1, 0}, 30, 5, {1, 1, 1})), target));
     // Just missing sideways: the cone edge passes beside the bounding sphere.
-    expectNothingEmitted(PhotonEmitter::forLight(Light(spotLight({0, 5, 0}, {1, -0.2f, 0}, 20, 5, {1, 1, 1})), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(spotLight({0, 5, 0}, {1, -0.2f, 0}, 20, 5, {1, 1, 1})), target));
 }
 
 TEST(PhotonEmissionZero, ZeroIntensityAndDegenerateLights) {
     PhotonTarget target = boundedTarget({-1, -1, -1}, {1, 1, 1});
     const Color black(0, 0, 0);
-    expectNothingEmitted(PhotonEmitter::forLight(Light(pointLight({0, 0, 0}, black)), target));
-    expectNothingEmitted(PhotonEmitter::forLight(Light(pointLight({5, 0, 0}, black)), target));
-    expectNothingEmitted(PhotonEmitter::forLight(Light(spotLight({0, 3, 0}, {0, -1, 0}, 30, 5, black)), target));
-    expectNothingEmitted(PhotonEmitter::forLight(Light(spotLight({0, 3, 0}, {0, -1, 0}, 0, 0, {1, 1, 1})), target));
-    expectNothingEmitted(PhotonEmitter::forLight(Light(directionalLight({0, -1, 0}, black)), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(pointLight({0, 0, 0}, black)), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(pointLight({5, 0, 0}, black)), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(spotLight({0, 3, 0}, {0, -1, 0}, 30, 5, black)), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(spotLight({0, 3, 0}, {0, -1, 0}, 0, 0, {1, 1, 1})), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(directionalLight({0, -1, 0}, black)), target));
     expectNothingEmitted(
-        PhotonEmitter::forLight(Light(quadLight({0, 3, 0}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, black)), target));
+        PhotonEmitter::forLight(*makeLight(quadLight({0, 3, 0}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, black)), target));
     // Quad seen edge-on along the beam: no area, no flux.
     expectNothingEmitted(
-        PhotonEmitter::forLight(Light(quadLight({0, 3, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {1, 1, 1})), target));
-    expectNothingEmitted(PhotonEmitter::forLight(Light(sphereLight({0, 0, 0}, 0.5f, black)), target));
+        PhotonEmitter::forLight(*makeLight(quadLight({0, 3, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {1, 1, 1})), target));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(sphereLight({0, 0, 0}, 0.5f, black)), target));
     expectNothingEmitted(PhotonEmitter::forEnvironment(black, target));
 }
 
 TEST(PhotonEmissionZero, EmptyOrDegenerateTarget) {
     PhotonTarget empty;  // bounded, empty box: nothing scatters
     const Color one(1, 1, 1);
-    expectNothingEmitted(PhotonEmitter::forLight(Light(pointLight({0, 0, 0}, one)), empty));
-    expectNothingEmitted(PhotonEmitter::forLight(Light(sphereLight({0, 0, 0}, 0.5f, one)), empty));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(pointLight({0, 0, 0}, one)), empty));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(sphereLight({0, 0, 0}, 0.5f, one)), empty));
     expectNothingEmitted(PhotonEmitter::forEnvironment(one, empty));
     // Unbounded with no finite box: the disc emitters have nowhere to aim.
-    expectNothingEmitted(PhotonEmitter::forLight(Light(directionalLight({0, -1, 0}, one)), {BBox(), true}));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(directionalLight({0, -1, 0}, one)), {BBox(), true}));
     // A single point scatters nothing measurable.
     PhotonTarget point = boundedTarget({0, 0, 0}, {0, 0, 0});
-    expectNothingEmitted(PhotonEmitter::forLight(Light(directionalLight({0, -1, 0}, one)), point));
-    expectNothingEmitted(PhotonEmitter::forLight(Light(pointLight({1, 0, 0}, one)), point));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(directionalLight({0, -1, 0}, one)), point));
+    expectNothingEmitted(PhotonEmitter::forLight(*makeLight(pointLight({1, 0, 0}, one)), point));
 }
 
 // Odd but legal inputs: finite photons throughout.
@@ -545,7 +545,7 @@ TEST(PhotonEmissionZero, ExtremeInputsStayFinite) {
         pointLight({0, 1e6f, 0}, one),                       // very distant point
     };
     for (const LightDesc& d : lights) {
-        PhotonEmitter e = PhotonEmitter::forLight(Light(d), target);
+        PhotonEmitter e = PhotonEmitter::forLight(*makeLight(d), target);
         EXPECT_TRUE(isFinite(e.power()));
         Shot s = shoot(e, {}, 20000, 90);
         EXPECT_EQ(s.badPhotons, 0);

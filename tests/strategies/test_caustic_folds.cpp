@@ -20,20 +20,20 @@ namespace {
 // The paper's figure 4: a point light 1.85 over a ball of radius 0.45.
 GlassSphere ball() { return test::figure4Ball(); }
 
-Light pointLight() {
+std::unique_ptr<Light> pointLight() {
     LightDesc d;
     d.type = LightDesc::Type::Point;
     d.position = Vec3(0.f, 2.6f, 0.f);
     d.intensity = Color(1.f);
-    return Light(d);
+    return makeLight(d);
 }
 
-Light sun() {
+std::unique_ptr<Light> sun() {
     LightDesc d;
     d.type = LightDesc::Type::Directional;
     d.direction = normalize(Vec3(0.3f, -1.f, 0.2f));
     d.irradiance = Color(1.f);
-    return Light(d);
+    return makeLight(d);
 }
 
 // The point of the fold's polyline at vertex k, turned by phi about the axis.
@@ -67,7 +67,8 @@ double connectedLight(const GlassSphere& s, const Light& l, const Vec3& x, int* 
 
 TEST(CausticFolds, TwoConnectionsAppearAcrossTheFold) {
     const GlassSphere s = ball();
-    for (const Light& l : {pointLight(), sun()}) {
+    for (const auto& light : {pointLight(), sun()}) {
+        const Light& l = *light;
         CausticFold f;
         ASSERT_TRUE(causticFold(s, l, f));
         ASSERT_GE(f.z.size(), 100u);
@@ -94,7 +95,8 @@ TEST(CausticFolds, RaysCrossTheFoldWhereTheConnectionsMerge) {
     // connections changes by two, found by bisection with the solver alone,
     // is the crossing foldCrossings finds.
     const GlassSphere s = ball();
-    for (const Light& l : {pointLight(), sun()}) {
+    for (const auto& light : {pointLight(), sun()}) {
+        const Light& l = *light;
         CausticFold f;
         ASSERT_TRUE(causticFold(s, l, f));
         Rng rng(9);
@@ -151,7 +153,7 @@ TEST(CausticFolds, NoFoldForALightInsideTheBall) {
     d.position = s.center + Vec3(0.1f, 0.f, 0.f);
     d.intensity = Color(1.f);
     CausticFold f;
-    EXPECT_FALSE(causticFold(s, Light(d), f));
+    EXPECT_FALSE(causticFold(s, *makeLight(d), f));
 }
 
 // The mass of one crossing's window (at tf, half-width w) in [a, b): on a
