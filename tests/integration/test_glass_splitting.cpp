@@ -22,32 +22,32 @@ namespace {
 
 using namespace test;
 
-Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool split, int seed = 3) {
+Image renderWithSplitting(const std::string& sample, const std::vector<std::string>& overrides, bool split, int seed = 3) {
     return renderSampleToggled(sample, overrides, "experiments.glass_splitting", split, seed);
 }
 
-const std::vector<std::string> CausticScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
+const std::vector<std::string> SplittingScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
                                                "render.max_depth=4", "render.spp=768"};
 
 TEST(GlassSplitting, ThePathTracerAgreesWithTheFresnelChoice) {
-    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", CausticScene, false),
-                          renderWith("scenes/fig4_caustic_sphere.json", CausticScene, true), "fig4_caustic_sphere");
+    expectPairedAgreement(renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, false),
+                          renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, true), "fig4_caustic_sphere");
 }
 
 TEST(GlassSplitting, ACloudWithGlassLightsAndSkyAgreesWithTheFresnelChoice) {
     std::vector<std::string> o = cloudSkyWithLightsAndGlass();
     o.insert(o.end(), {"render.method=\"reference\"", "render.spp=256"});
-    expectPairedAgreement(renderWith("cloud_sky.json", o, false), renderWith("cloud_sky.json", o, true), "cloud_sky");
+    expectPairedAgreement(renderWithSplitting("cloud_sky.json", o, false), renderWithSplitting("cloud_sky.json", o, true), "cloud_sky");
 }
 
 TEST(GlassSplitting, TheGuidedMarcherAgreesWithTheFresnelChoice) {
     const std::vector<std::string> glass = {"camera.resolution=[32,24]", "render.method=\"guided\"", "render.spp=64"};
-    expectPairedAgreement(renderWith("glass.json", glass, false), renderWith("glass.json", glass, true), "glass.json");
-    std::vector<std::string> caustic = CausticScene;
+    expectPairedAgreement(renderWithSplitting("glass.json", glass, false), renderWithSplitting("glass.json", glass, true), "glass.json");
+    std::vector<std::string> caustic = SplittingScene;
     caustic[1] = "render.method=\"guided\"";
     caustic.back() = "render.spp=96";
-    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", caustic, false),
-                          renderWith("scenes/fig4_caustic_sphere.json", caustic, true), "guided on fig4_caustic_sphere");
+    expectPairedAgreement(renderWithSplitting("scenes/fig4_caustic_sphere.json", caustic, false),
+                          renderWithSplitting("scenes/fig4_caustic_sphere.json", caustic, true), "guided on fig4_caustic_sphere");
 }
 
 TEST(GlassSplitting, AFurnaceOfGlassInWhiteFogStaysAtTheBackground) {
@@ -79,8 +79,8 @@ TEST(GlassSplitting, TheLightMirroredInTheBallIsQuiet) {
     // Pair MSE of two seeds, on and off: measured 0.09-0.18x with seed
     // pairs 11/23 and 5/7 at this size; at most half here.
     auto noise = [](bool split) {
-        return pairMse(renderWith("scenes/fig4_caustic_sphere.json", CausticScene, split, 11),
-                       renderWith("scenes/fig4_caustic_sphere.json", CausticScene, split, 23));
+        return pairMse(renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, split, 11),
+                       renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, split, 23));
     };
     EXPECT_LT(noise(true), 0.5 * noise(false));
 }

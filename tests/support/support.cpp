@@ -247,6 +247,10 @@ bool allFinite(const Image& img) {
     return true;
 }
 
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
 float maxAlpha(const Image& img) {
     float a = 0;
     for (int y = 0; y < img.height; ++y)

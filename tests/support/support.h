@@ -233,6 +233,8 @@ std::vector<std::string> cloudSkyWithLightsAndGlass();
 // Images
 
 bool allFinite(const Image& img);
+// True when the two hold the same floats, bit for bit.
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b);
 float maxAlpha(const Image& img);
 // Every pixel shows exactly `bg` with alpha 0 (nothing in front of it).
 void expectBackgroundEverywhere(const Image& img, const Color& bg, float tol = 1e-6f);
