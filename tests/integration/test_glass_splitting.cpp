@@ -1,4 +1,4 @@
-// Glass splitting (experiments.glass_splitting; transport/surface_event.h,
+// Glass splitting (experiments.glass_splitting; strategies/glass_splitting.h,
 // SplitDielectricEvents; transport/transmittance.h, mirroredLight): camera
 // paths follow both outcomes of their first glass event, weighted by their
 // Fresnel chances, and every other glass event counts the light its
@@ -58,15 +58,7 @@ TEST(GlassSplitting, AFurnaceOfGlassInWhiteFogStaysAtTheBackground) {
     // transmittance estimates and skip it when they take the reflection
     // (counting it twice measured 1.0 % too bright in the path tracer); ior 2.4 reflects a lot.
     for (const char* method : {"reference", "guided"}) {
-        auto scene = sceneFromJson(str(R"({"camera": {"position": [0.3, 0.4, 4], "look_at": [0, 0, 0], "fov_deg": 45,
-            "resolution": [16, 16]},
-            "media": [{"name": "fog", "type": "homogeneous", "sigma_a": 0, "sigma_s": 0.8,
-                       "bounds": {"min": [-2, -2, -2], "max": [2, 2, 2]}}],
-            "surfaces": [{"shape": "sphere", "transform": {"scale": [1, 0.7, 0.9]}, "material": {"type": "dielectric", "ior": 1.5}},
-                         {"shape": "box", "transform": {"scale": 0.8, "rotate": [1, 1, 0, 30], "translate": [0.6, 0.3, 1]},
-                          "material": {"type": "dielectric", "ior": 2.4}}],
-            "background": [1, 1, 1], "photons": {"count": 20000},
-            "render": {"method": ")", method, R"(", "spp": 64, "max_depth": 1000, "max_surface_bounces": 1000, "seed": 5}})"));
+        auto scene = glassInWhiteFog(method, true);
         const RenderResult r = renderImage(*scene);
         for (int c = 0; c < 3; ++c) {
             const ChannelStats st = pixelStats(r.image, c);
