@@ -4,7 +4,6 @@
 
 #include "core/error.h"
 #include "transport/direct_light.h"
-#include "strategies/glass_splitting.h"
 #include "paths/path_tracer.h"
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
@@ -88,10 +87,11 @@ PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, Threa
         ++ctx.counters.surfaceHits;
         if (path.bounce >= scene.desc.render.maxSurfaceBounces) return done(0.f);
         const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
-        // Glass may split the camera path, or count the light its
-        // reflection sees (glass_splitting.h).
-        const bool split = path.diffuseBounces == 0 && path.glassSplits < SplitDielectricEvents;
-        const PathSurfaceEvent pe = pathSurfaceEvent(ctx, h, ray.d, region, u, split, path.diffuseBounces == 0, rng);
+        // A surface strategy may split the camera path at glass, or count
+        // the light its reflection sees (strategies/glass_splitting.h).
+        const SurfaceRequest request{path.diffuseBounces == 0 && path.glassSplits < SplitDielectricEvents,
+                                     path.diffuseBounces == 0};
+        const PathSurfaceEvent pe = mPaths.strategies().surfaceEvent(ctx, h, ray.d, region, u, request, rng);
         addSeen(beta * pe.light);
         if (path.diffuseBounces == 0) mirroredThrough += average(beta) * pe.backgroundSeen;
         path.mirrorCounted = pe.mirrorCounted;
@@ -121,8 +121,9 @@ PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, Threa
             // point and spot lights, which no path finds; sphere lights too
             // where max_depth ends the path here, else the path below finds them.
             const bool last = path.diffuseBounces + 1 >= scene.desc.render.maxDepth;
-            for (const ConnectionStrategy* c : mPaths.strategies().connections())
-                if (c->active()) Ld += beta * c->connect(ctx, region, vertex, rng, {last, true, !last});
+            bool connected;
+            const Color Lc = mPaths.strategies().connect(ctx, region, vertex, rng, {last, true, !last}, connected);
+            if (connected) Ld += beta * Lc;
             L += Ld;
             if (mTallyDirect && path.diffuseBounces == 0) scratch(ctx).direct += Ld;
             // Light that reaches the surface after scattering in a medium
@@ -196,13 +197,11 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     // weighed against the continuation's own hits: sphere lights, and point
     // and spot lights, whose photons then leave these caustics out
     // (strategies/sphere_caustics.h, Photon::Connected).
-    bool connected = false;
-    for (const ConnectionStrategy* c : mPaths.strategies().connections()) {
-        if (!c->active()) continue;
-        const Color Lc = c->connect(ctx, region, nextEventVertex, rng, {});
+    bool connected;
+    const Color Lc = mPaths.strategies().connect(ctx, region, nextEventVertex, rng, {}, connected);
+    if (connected) {
         Li += Lc;
         if (tallyHere) m.liDirect += Lc;
-        connected = true;
     }
     const bool tracePathHere = pathProbability >= 1 || rng.uniform() < pathProbability;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "strategies/glass_splitting.h"
 #include "transport/media_point.h"
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
@@ -118,12 +117,10 @@ bool PathWalk::nextEvent(const ScatterVertex& vertex, const CollisionWeights& w)
     DirectLightOptions o{TransmittanceEstimator::UnbiasedMarching, true, false, byPhotons, w.lightWeights};
     o.phaseRoulette = true;
     add(beta * directLight(ctx, region, vertex, rng, o), st.depth);
-    bool connected = false;
-    for (const ConnectionStrategy* c : strategies.connections()) {
-        if (!c->active()) continue;
-        add(beta * c->connect(ctx, region, vertex, rng, {true, !byPhotons, true, true, w.connectionWeight}), st.depth);
-        connected = true;
-    }
+    bool connected;
+    const Color Lc = strategies.connect(ctx, region, vertex, rng, {true, !byPhotons, true, true, w.connectionWeight},
+                                        connected);
+    if (connected) add(beta * Lc, st.depth);
     return connected;
 }
 
@@ -173,8 +170,7 @@ void PathWalk::hitLight(int light, float tEnd) {
     if (!st.specular) {
         w = powerHeuristic(st.lastPdf, l.directionPdf(st.lastPoint));
     } else if (st.connectedAtLast) {
-        for (const ConnectionStrategy* c : strategies.connections())
-            if (c->active()) w *= c->pathHitWeight(st.chain, light, st.lastPoint, st.lastDir, st.lastPdf, ray.at(tEnd));
+        w = strategies.pathHitWeight(st.chain, light, st.lastPoint, st.lastDir, st.lastPdf, ray.at(tEnd));
     }
     if (!st.mirrorCounted) addEmitted(beta * l.emittedRadiance() * w, st.depth);
 }
@@ -184,10 +180,10 @@ bool PathWalk::surfaceEvent(const SurfaceHit& h) {
     ++ctx.counters.surfaceHits;
     if (++st.surfaceBounces > scene.desc.render.maxSurfaceBounces) return false;
     const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
-    // Glass may split a camera path, or count the light its reflection
-    // sees (glass_splitting.h).
-    const bool split = st.depth == 0 && st.glassSplits < SplitDielectricEvents;
-    const PathSurfaceEvent pe = pathSurfaceEvent(ctx, h, ray.d, region, u, split, st.depth == 0, rng);
+    // A surface strategy may split a camera path at glass, or count the
+    // light its reflection sees (strategies/glass_splitting.h).
+    const SurfaceRequest request{st.depth == 0 && st.glassSplits < SplitDielectricEvents, st.depth == 0};
+    const PathSurfaceEvent pe = strategies.surfaceEvent(ctx, h, ray.d, region, u, request, rng);
     add(beta * pe.light, st.depth);
     st.mirrorCounted = pe.mirrorCounted;
     if (pe.split) {

@@ -21,22 +21,22 @@ uint64_t spreadBits(uint64_t v) {
     return v;
 }
 
-// A contiguous range of the map's photons.
-struct PhotonCloud {
-    const Photon* photons;
-    size_t count;
-    size_t kdtree_get_point_count() const { return count; }
-    float kdtree_get_pt(size_t i, size_t dim) const { return photons[i].position[int(dim)]; }
-    template <class Box>
-    bool kdtree_get_bbox(Box&) const { return false; }
-};
-
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PhotonCloud>, PhotonCloud, 3,
-                                                   uint32_t>;
-
 }  // namespace
 
 struct PhotonMap::Tree {
+    // A contiguous range of the map's photons.
+    struct PhotonCloud {
+        const Photon* photons;
+        size_t count;
+        size_t kdtree_get_point_count() const { return count; }
+        float kdtree_get_pt(size_t i, size_t dim) const { return photons[i].position[int(dim)]; }
+        template <class Box>
+        bool kdtree_get_bbox(Box&) const { return false; }
+    };
+
+    using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PhotonCloud>, PhotonCloud, 3,
+                                                       uint32_t>;
+
     PhotonCloud cloud;
     uint32_t first;  // index of cloud.photons[0] in the map
     KdTree index;

@@ -1,5 +1,5 @@
 // The sampling strategies a path can use besides delta tracking and f's own
-// direction sampling, as three small interfaces that every path loop
+// direction sampling, as four small interfaces that every path loop
 // iterates (paths/path_tracer.h, the marchers' L_i samples):
 //  - a DistanceStrategy draws positions along a path segment, towards
 //    where light concentrates, and weighs them against the tracking
@@ -10,7 +10,9 @@
 //    3's pdf_direction; directions towards beams);
 //  - a ConnectionStrategy brings light through specular surfaces that
 //    shadow rays cannot follow, with the MIS weight a path that reaches the
-//    light through the same surfaces gets (sphere caustics).
+//    light through the same surfaces gets (sphere caustics);
+//  - a SurfaceStrategy decides a radiance path's event at a surface in
+//    place of the material's own sampling (glass splitting).
 // Each is built once per render from the scene (strategy_set.h) with its
 // tables; per-segment and per-vertex state lives in the thread context's
 // extension slot the set gives it.
@@ -20,6 +22,7 @@
 #include "transport/direct_light.h"
 #include "transport/media_point.h"
 #include "transport/roulette.h"
+#include "transport/surface_event.h"
 #include "transport/thread_context.h"
 #include "transport/transmittance.h"
 
@@ -109,6 +112,42 @@ public:
     // makes no connection of that pattern.
     virtual float pathHitWeight(const SpecularChain& chain, int light, const Vec3& x, const Vec3& w, float pathPdf,
                                 const Vec3& y) const = 0;
+};
+
+// A radiance path's event at a surface, as the path loops take it.
+struct PathSurfaceEvent {
+    SurfaceEvent event;  // the outcome the path goes on with
+    Color weight;        // its weight
+    // The reflection to trace beside it, weighted mirrorWeight (split).
+    bool split = false;
+    SurfaceEvent mirror;
+    Color mirrorWeight;
+    // Light counted at the event, to be multiplied by the path's throughput:
+    // what the reflection sees, with MIS weight 1 (a light hit after a
+    // reflection breaks every sphere caustic pattern).
+    Color light;
+    // The part of `light`'s weight that is the background seen through
+    // (alpha: a camera path that sees the background in glass).
+    float backgroundSeen = 0;
+    // The path took a reflection whose light was counted: it must not count
+    // the light or background its next segment ends on.
+    bool mirrorCounted = false;
+};
+
+// What the path loop tells a surface strategy about the path.
+struct SurfaceRequest {
+    bool split = false;           // the path may follow both outcomes here (a camera path's first glass events)
+    bool seenFromCamera = false;  // the path has not scattered yet (it sees the environment map as a backdrop)
+};
+
+class SurfaceStrategy {
+public:
+    virtual ~SurfaceStrategy() = default;
+    // True when this strategy decides the event at `hit` for a path
+    // travelling along d in `region` (and fills `out`); u: three uniforms
+    // (the Fresnel choice, then the diffuse direction).
+    virtual bool sample(ThreadContext& ctx, const SurfaceHit& hit, const Vec3& d, int region, const float u[3],
+                        const SurfaceRequest& request, Rng& rng, PathSurfaceEvent& out) const = 0;
 };
 
 // The density with which delta tracking makes a scattering collision at t,

@@ -2,6 +2,7 @@
 
 #include "strategies/beam_directions.h"
 #include "strategies/caustic_folds.h"
+#include "strategies/glass_splitting.h"
 #include "strategies/light_distances.h"
 #include "strategies/sphere_caustics.h"
 
@@ -21,6 +22,7 @@ std::shared_ptr<StrategySet> StrategySet::build(const Scene& scene) {
     set->add(std::move(folds));
     set->add(std::move(beams));
     set->add(std::make_unique<SphereCaustics>(scene));
+    if (scene.desc.experiments.glassSplitting) set->add(std::make_unique<GlassSplitting>());
     return set;
 }
 
@@ -37,6 +39,39 @@ void StrategySet::add(std::unique_ptr<DirectionStrategy> s) {
 void StrategySet::add(std::unique_ptr<ConnectionStrategy> s) {
     mConnections.push_back(s.get());
     mOwnedConnections.push_back(std::move(s));
+}
+
+void StrategySet::add(std::unique_ptr<SurfaceStrategy> s) {
+    mSurfaces.push_back(s.get());
+    mOwnedSurfaces.push_back(std::move(s));
+}
+
+Color StrategySet::connect(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
+                           const ConnectionRequest& request, bool& connected) const {
+    Color L(0);
+    connected = false;
+    for (const ConnectionStrategy* c : mConnections) {
+        if (!c->active()) continue;
+        L += c->connect(ctx, region, v, rng, request);
+        connected = true;
+    }
+    return L;
+}
+
+float StrategySet::pathHitWeight(const SpecularChain& chain, int light, const Vec3& x, const Vec3& w, float pathPdf,
+                                 const Vec3& y) const {
+    float weight = 1;
+    for (const ConnectionStrategy* c : mConnections)
+        if (c->active()) weight *= c->pathHitWeight(chain, light, x, w, pathPdf, y);
+    return weight;
+}
+
+PathSurfaceEvent StrategySet::surfaceEvent(ThreadContext& ctx, const SurfaceHit& hit, const Vec3& d, int region,
+                                           const float u[3], const SurfaceRequest& request, Rng& rng) const {
+    PathSurfaceEvent out;
+    for (const SurfaceStrategy* s : mSurfaces)
+        if (s->sample(ctx, hit, d, region, u, request, rng, out)) return out;
+    return materialSurfaceEvent(ctx.scene, hit, d, region, u);
 }
 
 bool StrategySet::needsSegmentEnd(int region, bool skipPointLights) const {

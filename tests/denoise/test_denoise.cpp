@@ -14,9 +14,12 @@
 #include "core/rng.h"
 #include "denoise/denoise.h"
 #include "image/metrics.h"
+#include "support/support.h"
 
 namespace vdbmarch {
 namespace {
+
+using test::allFinite;
 
 // Standard normal by Box-Muller from the project's PCG32 (portable, unlike
 // std::normal_distribution).
@@ -154,11 +157,6 @@ double meanRgb(const Image& img) {
     return sum / double(img.pixelCount() * 3);
 }
 
-bool allFinite(const Image& img) {
-    for (float v : img.rgba)
-        if (!std::isfinite(v)) return false;
-    return true;
-}
 
 TEST(DenoiseExact, AConstantNoiseFreeFrameComesBackUnchanged) {
     const int w = 45, h = 37;  // partial tiles on both axes

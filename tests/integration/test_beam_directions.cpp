@@ -17,7 +17,7 @@ namespace {
 
 using namespace test;
 
-Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool beams, int seed = 3) {
+Image renderWithBeams(const std::string& sample, const std::vector<std::string>& overrides, bool beams, int seed = 3) {
     return renderSampleToggled(sample, overrides, "experiments.beam_directions", beams, seed);
 }
 
@@ -27,8 +27,8 @@ const std::vector<std::string> SpotScene = {"camera.resolution=[32,24]", "render
                                             "render.max_depth=8", "render.spp=384"};
 
 TEST(BeamDirectionRenders, SpotsInHazeOverAFloorAgreeWithPhaseAndCosineAlone) {
-    const Image on = renderWith("scenes/fig3b_spots.json", SpotScene, true);
-    const Image off = renderWith("scenes/fig3b_spots.json", SpotScene, false);
+    const Image on = renderWithBeams("scenes/fig3b_spots.json", SpotScene, true);
+    const Image off = renderWithBeams("scenes/fig3b_spots.json", SpotScene, false);
     expectPairedAgreement(off, on, "fig3b_spots");
 }
 
@@ -46,8 +46,8 @@ TEST(BeamDirectionRenders, ASpotInsideTwoOverlappingHazesUnderASkyAgreesWithPhas
                           {"name": "mist", "type": "homogeneous", "sigma_a": 0.01, "sigma_s": [0.2, 0.3, 0.4],
                            "g": -0.4, "bounds": {"min": [-1, -0.8, -1.5], "max": [1.5, 0.6, 0.5]}}])");
     o.push_back("background=[0.1, 0.15, 0.25]");
-    const Image on = renderWith("scenes/fig3b_spots.json", o, true);
-    const Image off = renderWith("scenes/fig3b_spots.json", o, false);
+    const Image on = renderWithBeams("scenes/fig3b_spots.json", o, true);
+    const Image off = renderWithBeams("scenes/fig3b_spots.json", o, false);
     expectPairedAgreement(off, on, "a spot inside two hazes");
 }
 
@@ -69,8 +69,8 @@ TEST(BeamDirectionRenders, ACollimatedBeamInHazeAgreesWithPhaseAlone) {
     // direction and the continuation paths' vertices).
     for (const char* method : {"reference", "guided"}) {
         const std::vector<std::string> o = collimatedScene(method, std::string(method) == "guided" ? 48 : 384);
-        const Image on = renderWith("scenes/fig3b_spots.json", o, true);
-        const Image off = renderWith("scenes/fig3b_spots.json", o, false);
+        const Image on = renderWithBeams("scenes/fig3b_spots.json", o, true);
+        const Image off = renderWithBeams("scenes/fig3b_spots.json", o, false);
         expectPairedAgreement(off, on, std::string("a collimated beam, ") + method);
     }
 }
@@ -83,8 +83,8 @@ TEST(BeamDirectionRenders, BeamDirectionsQuietACollimatedBeam) {
     for (const char* method : {"reference", "guided"}) {
         auto noise = [&](bool beams) {
             const std::vector<std::string> o = collimatedScene(method, std::string(method) == "guided" ? 16 : 128);
-            return test::pairMse(renderWith("scenes/fig3b_spots.json", o, beams, 11),
-                                 renderWith("scenes/fig3b_spots.json", o, beams, 23));
+            return test::pairMse(renderWithBeams("scenes/fig3b_spots.json", o, beams, 11),
+                                 renderWithBeams("scenes/fig3b_spots.json", o, beams, 23));
         };
         EXPECT_LT(noise(true), 0.6 * noise(false)) << method;
     }
@@ -97,7 +97,7 @@ TEST(BeamDirectionRenders, DenseMediaKeepTheirOwnDirections) {
         "camera.resolution=[16,12]", "render.method=\"reference\"", "render.max_depth=4", "render.spp=4",
         R"(lights=[{"type": "spot", "position": [0.1, 0.6, 0.2], "direction": [0.2, -1, -0.1], "intensity": [6, 5, 4],
                     "cone_deg": 15, "falloff_deg": 4}])"};
-    const Image on = renderWith("cloud.json", o, true), off = renderWith("cloud.json", o, false);
+    const Image on = renderWithBeams("cloud.json", o, true), off = renderWithBeams("cloud.json", o, false);
     for (int y = 0; y < on.height; ++y)
         for (int x = 0; x < on.width; ++x) ASSERT_EQ(on.rgb(x, y), off.rgb(x, y));
 }
@@ -109,8 +109,8 @@ TEST(BeamDirectionRenders, BeamDirectionsQuietTheSpotScene) {
     auto noise = [](bool beams) {
         std::vector<std::string> o = SpotScene;
         o.back() = "render.spp=128";
-        return test::pairMse(renderWith("scenes/fig3b_spots.json", o, beams, 11),
-                             renderWith("scenes/fig3b_spots.json", o, beams, 23));
+        return test::pairMse(renderWithBeams("scenes/fig3b_spots.json", o, beams, 11),
+                             renderWithBeams("scenes/fig3b_spots.json", o, beams, 23));
     };
     EXPECT_LT(noise(true), 0.18 * noise(false));
 }

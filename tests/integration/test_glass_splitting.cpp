@@ -1,4 +1,4 @@
-// Glass splitting (experiments.glass_splitting; transport/surface_event.h,
+// Glass splitting (experiments.glass_splitting; strategies/glass_splitting.h,
 // SplitDielectricEvents; transport/transmittance.h, mirroredLight): camera
 // paths follow both outcomes of their first glass event, weighted by their
 // Fresnel chances, and every other glass event counts the light its
@@ -22,32 +22,32 @@ namespace {
 
 using namespace test;
 
-Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool split, int seed = 3) {
+Image renderWithSplitting(const std::string& sample, const std::vector<std::string>& overrides, bool split, int seed = 3) {
     return renderSampleToggled(sample, overrides, "experiments.glass_splitting", split, seed);
 }
 
-const std::vector<std::string> CausticScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
+const std::vector<std::string> SplittingScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
                                                "render.max_depth=4", "render.spp=768"};
 
 TEST(GlassSplitting, ThePathTracerAgreesWithTheFresnelChoice) {
-    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", CausticScene, false),
-                          renderWith("scenes/fig4_caustic_sphere.json", CausticScene, true), "fig4_caustic_sphere");
+    expectPairedAgreement(renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, false),
+                          renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, true), "fig4_caustic_sphere");
 }
 
 TEST(GlassSplitting, ACloudWithGlassLightsAndSkyAgreesWithTheFresnelChoice) {
     std::vector<std::string> o = cloudSkyWithLightsAndGlass();
     o.insert(o.end(), {"render.method=\"reference\"", "render.spp=256"});
-    expectPairedAgreement(renderWith("cloud_sky.json", o, false), renderWith("cloud_sky.json", o, true), "cloud_sky");
+    expectPairedAgreement(renderWithSplitting("cloud_sky.json", o, false), renderWithSplitting("cloud_sky.json", o, true), "cloud_sky");
 }
 
 TEST(GlassSplitting, TheGuidedMarcherAgreesWithTheFresnelChoice) {
     const std::vector<std::string> glass = {"camera.resolution=[32,24]", "render.method=\"guided\"", "render.spp=64"};
-    expectPairedAgreement(renderWith("glass.json", glass, false), renderWith("glass.json", glass, true), "glass.json");
-    std::vector<std::string> caustic = CausticScene;
+    expectPairedAgreement(renderWithSplitting("glass.json", glass, false), renderWithSplitting("glass.json", glass, true), "glass.json");
+    std::vector<std::string> caustic = SplittingScene;
     caustic[1] = "render.method=\"guided\"";
     caustic.back() = "render.spp=96";
-    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", caustic, false),
-                          renderWith("scenes/fig4_caustic_sphere.json", caustic, true), "guided on fig4_caustic_sphere");
+    expectPairedAgreement(renderWithSplitting("scenes/fig4_caustic_sphere.json", caustic, false),
+                          renderWithSplitting("scenes/fig4_caustic_sphere.json", caustic, true), "guided on fig4_caustic_sphere");
 }
 
 TEST(GlassSplitting, AFurnaceOfGlassInWhiteFogStaysAtTheBackground) {
@@ -58,15 +58,7 @@ TEST(GlassSplitting, AFurnaceOfGlassInWhiteFogStaysAtTheBackground) {
     // transmittance estimates and skip it when they take the reflection
     // (counting it twice measured 1.0 % too bright in the path tracer); ior 2.4 reflects a lot.
     for (const char* method : {"reference", "guided"}) {
-        auto scene = sceneFromJson(str(R"({"camera": {"position": [0.3, 0.4, 4], "look_at": [0, 0, 0], "fov_deg": 45,
-            "resolution": [16, 16]},
-            "media": [{"name": "fog", "type": "homogeneous", "sigma_a": 0, "sigma_s": 0.8,
-                       "bounds": {"min": [-2, -2, -2], "max": [2, 2, 2]}}],
-            "surfaces": [{"shape": "sphere", "transform": {"scale": [1, 0.7, 0.9]}, "material": {"type": "dielectric", "ior": 1.5}},
-                         {"shape": "box", "transform": {"scale": 0.8, "rotate": [1, 1, 0, 30], "translate": [0.6, 0.3, 1]},
-                          "material": {"type": "dielectric", "ior": 2.4}}],
-            "background": [1, 1, 1], "photons": {"count": 20000},
-            "render": {"method": ")", method, R"(", "spp": 64, "max_depth": 1000, "max_surface_bounces": 1000, "seed": 5}})"));
+        auto scene = glassInWhiteFog(method, true);
         const RenderResult r = renderImage(*scene);
         for (int c = 0; c < 3; ++c) {
             const ChannelStats st = pixelStats(r.image, c);
@@ -79,8 +71,8 @@ TEST(GlassSplitting, TheLightMirroredInTheBallIsQuiet) {
     // Pair MSE of two seeds, on and off: measured 0.09-0.18x with seed
     // pairs 11/23 and 5/7 at this size; at most half here.
     auto noise = [](bool split) {
-        return pairMse(renderWith("scenes/fig4_caustic_sphere.json", CausticScene, split, 11),
-                       renderWith("scenes/fig4_caustic_sphere.json", CausticScene, split, 23));
+        return pairMse(renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, split, 11),
+                       renderWithSplitting("scenes/fig4_caustic_sphere.json", SplittingScene, split, 23));
     };
     EXPECT_LT(noise(true), 0.5 * noise(false));
 }

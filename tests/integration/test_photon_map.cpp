@@ -63,11 +63,11 @@ float directLiOverBall(const Vec3& x, const Vec3& wo, float g, float radius) {
     return float(sum / n);
 }
 
-struct Estimate {
+struct PhotonEstimate {
     double mean = 0, stdError = 0;
 };
 
-Estimate meanAndError(const std::vector<double>& v) {
+PhotonEstimate meanAndError(const std::vector<double>& v) {
     double m = 0, s = 0;
     for (double x : v) m += x;
     m /= double(v.size());
@@ -78,7 +78,7 @@ Estimate meanAndError(const std::vector<double>& v) {
 // L_i scattered at least once before x (up to depth - 1 events), by the
 // reference tracer: phase-sample the light's travel direction t' around wo
 // and take the radiance arriving along it.
-Estimate referenceIndirect(const Scene& scene, const Vec3& x, const Vec3& wo, float g, int samples) {
+PhotonEstimate referenceIndirect(const Scene& scene, const Vec3& x, const Vec3& wo, float g, int samples) {
     auto tracer = makeEstimator(Method::Reference, scene);
     ThreadContext ctx(scene);
     std::vector<double> v;
@@ -121,12 +121,12 @@ void checkAgainstTruth(float g) {
         for (int di = 0; di < 3; ++di) {
             const Vec3& x = probes[pi];
             const Vec3& wo = dirs[di];
-            Estimate pd = meanAndError(direct[size_t(pi * 3 + di)]);
+            PhotonEstimate pd = meanAndError(direct[size_t(pi * 3 + di)]);
             double truth = meanAndError(smoothedTruth[size_t(pi * 3 + di)]).mean;
             EXPECT_NEAR(pd.mean, truth, 4 * pd.stdError)
                 << "direct photons, g " << g << " probe " << pi << " direction " << di << " (SE " << pd.stdError << ")";
-            Estimate pn = meanAndError(indirect[size_t(pi * 3 + di)]);
-            Estimate ref = referenceIndirect(*shorter, x, wo, g, 20000);
+            PhotonEstimate pn = meanAndError(indirect[size_t(pi * 3 + di)]);
+            PhotonEstimate ref = referenceIndirect(*shorter, x, wo, g, 20000);
             double se = std::sqrt(pn.stdError * pn.stdError + ref.stdError * ref.stdError);
             EXPECT_NEAR(pn.mean, ref.mean, 4 * se) << "scattered photons vs reference, g " << g << " probe " << pi
                                                    << " direction " << di;

@@ -21,7 +21,7 @@
 namespace vdbmarch {
 namespace {
 
-const std::string& workDir() {
+const std::string& smoothGlassDir() {
     static const test::TempDir dir("smooth_glass");
     return dir.path();
 }
@@ -52,8 +52,8 @@ std::string sceneText(bool smooth, bool smoke) {
 }
 
 Image render(bool smooth, bool smoke, Method method, int spp, uint64_t seed) {
-    const std::string file = workDir() + (smooth ? "/smooth" : "/flat") + (smoke ? "_smoke.json" : ".json");
-    test::writeIcosahedron(workDir() + "/ico.obj");
+    const std::string file = smoothGlassDir() + (smooth ? "/smooth" : "/flat") + (smoke ? "_smoke.json" : ".json");
+    test::writeIcosahedron(smoothGlassDir() + "/ico.obj");
     std::ofstream(file) << sceneText(smooth, smoke);
     SceneDesc d = loadSceneFile(file, {str("render.spp=", spp), str("render.seed=", seed)});
     d.render.method = method;

@@ -36,7 +36,7 @@ namespace {
 
 using namespace test;
 
-Image renderWith(const std::string& sample, const std::vector<std::string>& overrides, bool caustics, int seed = 3) {
+Image renderWithCaustics(const std::string& sample, const std::vector<std::string>& overrides, bool caustics, int seed = 3) {
     return renderSampleToggled(sample, overrides, "experiments.sphere_caustics", caustics, seed);
 }
 
@@ -44,7 +44,7 @@ Image renderWith(const std::string& sample, const std::vector<std::string>& over
 // that then take their place in media: the light paths find alone.
 Image pathsAlone(const std::string& sample, std::vector<std::string> overrides, int seed = 3) {
     overrides.push_back("photons.count=0");
-    return renderWith(sample, overrides, false, seed);
+    return renderWithCaustics(sample, overrides, false, seed);
 }
 
 const std::vector<std::string> CausticScene = {"camera.resolution=[32,24]", "render.method=\"reference\"",
@@ -55,8 +55,8 @@ const char* const LargeLight =
     R"(lights=[{"type": "sphere", "position": [0, 2.2, 0], "radius": 0.5, "power": [300, 290, 270]}])";
 
 TEST(SphereCausticRenders, FogAndFloorUnderAGlassBallAgreeWithPathsAlone) {
-    const Image on = renderWith("scenes/fig4_caustic_sphere.json", CausticScene, true);
-    const Image off = renderWith("scenes/fig4_caustic_sphere.json", CausticScene, false);
+    const Image on = renderWithCaustics("scenes/fig4_caustic_sphere.json", CausticScene, true);
+    const Image off = renderWithCaustics("scenes/fig4_caustic_sphere.json", CausticScene, false);
     expectPairedAgreement(off, on, "fig4_caustic_sphere");
 }
 
@@ -65,8 +65,8 @@ TEST(SphereCausticRenders, ALargeLightThatPathsFindOftenAgreesWithPathsAlone) {
     // share counts (connections, directions towards the ball, the paths).
     std::vector<std::string> o = CausticScene;
     o.push_back(LargeLight);
-    const Image on = renderWith("scenes/fig4_caustic_sphere.json", o, true);
-    const Image off = renderWith("scenes/fig4_caustic_sphere.json", o, false);
+    const Image on = renderWithCaustics("scenes/fig4_caustic_sphere.json", o, true);
+    const Image off = renderWithCaustics("scenes/fig4_caustic_sphere.json", o, false);
     expectPairedAgreement(off, on, "a large light over the ball");
 }
 
@@ -78,8 +78,8 @@ TEST(SphereCausticRenders, GuidedMarcherAgreesWithItsPathsAlone) {
     o.back() = "render.spp=128";
     o[1] = "render.method=\"guided\"";
     o.push_back(LargeLight);
-    const Image on = renderWith("scenes/fig4_caustic_sphere.json", o, true);
-    const Image off = renderWith("scenes/fig4_caustic_sphere.json", o, false);
+    const Image on = renderWithCaustics("scenes/fig4_caustic_sphere.json", o, true);
+    const Image off = renderWithCaustics("scenes/fig4_caustic_sphere.json", o, false);
     expectPairedAgreement(off, on, "guided on fig4_caustic_sphere");
 }
 
@@ -88,8 +88,8 @@ TEST(SphereCausticRenders, ConnectionsQuietTheCaustic) {
     // the noise per sample well below the paths' (measured 0.13x the MSE at
     // 160x120; here at least 2x less).
     auto noise = [](bool caustics) {
-        return test::pairMse(renderWith("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 11),
-                             renderWith("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 23));
+        return test::pairMse(renderWithCaustics("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 11),
+                             renderWithCaustics("scenes/fig4_caustic_sphere.json", CausticScene, caustics, 23));
     };
     EXPECT_LT(noise(true), 0.5 * noise(false));
 }
@@ -102,13 +102,13 @@ const char* const CloudSkySphereLight =
 TEST(SphereCausticRenders, CloudWithGlassLightsAndSkyAgreesWithPathsAlone) {
     std::vector<std::string> o = cloudSkyWithLightsAndGlass();
     o.insert(o.end(), {"render.method=\"reference\"", "render.spp=256", CloudSkySphereLight});
-    expectPairedAgreement(renderWith("cloud_sky.json", o, false), renderWith("cloud_sky.json", o, true), "cloud_sky");
+    expectPairedAgreement(renderWithCaustics("cloud_sky.json", o, false), renderWithCaustics("cloud_sky.json", o, true), "cloud_sky");
 }
 
 // A sphere light of radius r and power 4 pi I has the far-field intensity I
 // of a point light; at r = 0.01, 1.85 from the ball, the two differ by
 // (r / d)^2 ~ 3e-5 relative, far below the tests' errors.
-std::string pointLight(const char* position, const char* intensity) {
+std::string pointLightJson(const char* position, const char* intensity) {
     return std::string(R"({"type": "point", "position": )") + position + R"(, "intensity": )" + intensity + "}";
 }
 std::string smallSphereLight(const char* position, double intensity) {
@@ -118,13 +118,13 @@ std::string smallSphereLight(const char* position, double intensity) {
 
 TEST(SphereCausticRenders, APointLightAgreesWithASmallSphereLightOfItsIntensity) {
     std::vector<std::string> point = CausticScene, sphere = CausticScene;
-    point.push_back("lights=[" + pointLight("[0, 2.6, 0]", "23") + "]");
+    point.push_back("lights=[" + pointLightJson("[0, 2.6, 0]", "23") + "]");
     sphere.push_back("lights=[" + smallSphereLight("[0, 2.6, 0]", 23) + "]");
-    expectPairedAgreement(renderWith("scenes/fig4_caustic.json", sphere, true),
-                          renderWith("scenes/fig4_caustic.json", point, true), "point light over the ball");
+    expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic.json", sphere, true),
+                          renderWithCaustics("scenes/fig4_caustic.json", point, true), "point light over the ball");
     // And the connections carry light the paths cannot find: without
     // them the image is darker by far more than its noise.
-    const Image on = renderWith("scenes/fig4_caustic.json", point, true);
+    const Image on = renderWithCaustics("scenes/fig4_caustic.json", point, true);
     const Image off = pathsAlone("scenes/fig4_caustic.json", point);
     SampleStats diff;
     for (int y = 0; y < on.height; ++y)
@@ -134,8 +134,8 @@ TEST(SphereCausticRenders, APointLightAgreesWithASmallSphereLightOfItsIntensity)
     // nearly deterministic there, so this comparison is sharp (a missing
     // Fresnel factor, 8 % of the caustic, fails it).
     for (auto* o : {&point, &sphere}) o->insert(o->end(), {"media.0.sigma_s=0", "render.max_depth=1"});
-    expectPairedAgreement(renderWith("scenes/fig4_caustic.json", sphere, true),
-                          renderWith("scenes/fig4_caustic.json", point, true), "the floor's caustic");
+    expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic.json", sphere, true),
+                          renderWithCaustics("scenes/fig4_caustic.json", point, true), "the floor's caustic");
 }
 
 TEST(SphereCausticRenders, APointLightInACloudAgreesWithASmallSphereLight) {
@@ -143,9 +143,9 @@ TEST(SphereCausticRenders, APointLightInACloudAgreesWithASmallSphereLight) {
     const char* const at = "[-0.2, 0.75, 1.5]";
     std::vector<std::string> point = cloudSkyWithLightsAndGlass(), sphere = point;
     for (auto* o : {&point, &sphere}) o->insert(o->end(), {"render.method=\"reference\"", "render.spp=256"});
-    point.push_back("lights=[" + pointLight(at, "0.6") + "]");
+    point.push_back("lights=[" + pointLightJson(at, "0.6") + "]");
     sphere.push_back("lights=[" + smallSphereLight(at, 0.6) + "]");
-    expectPairedAgreement(renderWith("cloud_sky.json", sphere, true), renderWith("cloud_sky.json", point, true),
+    expectPairedAgreement(renderWithCaustics("cloud_sky.json", sphere, true), renderWithCaustics("cloud_sky.json", point, true),
                           "point light in cloud_sky");
 }
 
@@ -154,11 +154,11 @@ TEST(SphereCausticRenders, ASpotWhoseConeHoldsTheBallAddsThePointLightsCaustic) 
     // towards the ball, which this spot shares with the point light (the
     // ball subtends 14 degrees from the light; full intensity to 20).
     std::vector<std::string> point = CausticScene, spot = CausticScene;
-    point.push_back("lights=[" + pointLight("[0, 2.6, 0]", "23") + "]");
+    point.push_back("lights=[" + pointLightJson("[0, 2.6, 0]", "23") + "]");
     spot.push_back(R"(lights=[{"type": "spot", "position": [0, 2.6, 0], "direction": [0, -1, 0], "cone_deg": 25,
                               "falloff_deg": 5, "intensity": 23}])");
     auto added = [](const std::vector<std::string>& o) {
-        Image on = renderWith("scenes/fig4_caustic.json", o, true);
+        Image on = renderWithCaustics("scenes/fig4_caustic.json", o, true);
         const Image off = pathsAlone("scenes/fig4_caustic.json", o);
         for (size_t i = 0; i < on.rgba.size(); ++i) on.rgba[i] -= off.rgba[i];
         return on;
@@ -177,15 +177,15 @@ TEST(SphereCausticRenders, GuidedMarcherConnectsToPointLightsLikeThePathTracer) 
     const auto scene = buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), guided));
     EXPECT_TRUE(scene->deltaLightCaustics);
     EXPECT_FALSE(illuminationRequest(*scene, Method::Guided, {}).indirect);
-    expectPairedAgreement(renderWith("scenes/fig4_caustic.json", o, true),
-                          renderWith("scenes/fig4_caustic.json", guided, true), "guided on fig4_caustic");
+    expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic.json", o, true),
+                          renderWithCaustics("scenes/fig4_caustic.json", guided, true), "guided on fig4_caustic");
     // A sphere light: max_depth ends the marcher's path at the floor, so
     // the floor's connections carry all of its caustic there (no path hit
     // to weigh against).
     // The large light over the ball, whose caustic lights much of the floor.
     for (auto* v : {&o, &guided}) v->push_back(LargeLight);
-    expectPairedAgreement(renderWith("scenes/fig4_caustic.json", o, true),
-                          renderWith("scenes/fig4_caustic.json", guided, true), "guided, a sphere light");
+    expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic.json", o, true),
+                          renderWithCaustics("scenes/fig4_caustic.json", guided, true), "guided, a sphere light");
 }
 
 TEST(SphereCaustics, ThePathTracerWarnsWhereItMissesCaustics) {
@@ -236,8 +236,8 @@ TEST(SphereCausticRenders, SomethingInsideTheBallIsSeenByTheConnections) {
                               "material": {"type": "diffuse", "albedo": 0.3}},
                              {"shape": "box", "transform": {"scale": [6, 0.1, 6], "translate": [0, -0.85, 0]},
                               "material": {"type": "diffuse", "albedo": 0.5}}])");
-    const Image on = renderWith("scenes/fig4_caustic_sphere.json", o, true);
-    const Image off = renderWith("scenes/fig4_caustic_sphere.json", o, false);
+    const Image on = renderWithCaustics("scenes/fig4_caustic_sphere.json", o, true);
+    const Image off = renderWithCaustics("scenes/fig4_caustic_sphere.json", o, false);
     expectPairedAgreement(off, on, "a ball inside the glass ball");
 }
 
@@ -261,24 +261,24 @@ const char* const LightInTheMilk =
 TEST(SphereCausticRenders, ALightInAGlobeOfMilkAgreesWithPathsAlone) {
     // The fog and the floor see it across the surface once, through the milk.
     const auto o = globeOfMilk(LightInTheMilk);
-    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", o, false),
-                          renderWith("scenes/fig4_caustic_sphere.json", o, true), "a light in a globe of milk");
+    expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic_sphere.json", o, false),
+                          renderWithCaustics("scenes/fig4_caustic_sphere.json", o, true), "a light in a globe of milk");
 }
 
 TEST(SphereCausticRenders, ALightOverAGlobeOfMilkAgreesWithPathsAlone) {
     // The milk sees it across the surface once; the fog and the floor
     // through the ball and its milk.
     const auto o = globeOfMilk(LargeLight);
-    expectPairedAgreement(renderWith("scenes/fig4_caustic_sphere.json", o, false),
-                          renderWith("scenes/fig4_caustic_sphere.json", o, true), "a light over a globe of milk");
+    expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic_sphere.json", o, false),
+                          renderWithCaustics("scenes/fig4_caustic_sphere.json", o, true), "a light over a globe of milk");
 }
 
 TEST(SphereCausticRenders, PointLightsInAndOverAGlobeOfMilkAgreeWithSmallSphereLights) {
     for (const char* at : {"[0.08, 0.8, 0.05]", "[0, 2.6, 0]", "[0, 0.75, 0]"}) {
-        const std::string point = "lights=[" + pointLight(at, "5") + "]";
+        const std::string point = "lights=[" + pointLightJson(at, "5") + "]";
         const std::string sphere = "lights=[" + smallSphereLight(at, 5) + "]";
-        expectPairedAgreement(renderWith("scenes/fig4_caustic.json", globeOfMilk(sphere.c_str()), true),
-                              renderWith("scenes/fig4_caustic.json", globeOfMilk(point.c_str()), true),
+        expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic.json", globeOfMilk(sphere.c_str()), true),
+                              renderWithCaustics("scenes/fig4_caustic.json", globeOfMilk(point.c_str()), true),
                               std::string("a point light at ") + at + " and a globe of milk");
     }
 }
@@ -286,7 +286,7 @@ TEST(SphereCausticRenders, PointLightsInAndOverAGlobeOfMilkAgreeWithSmallSphereL
 TEST(SphereCausticRenders, GuidedMarcherConnectsThroughAGlobeOfMilkLikeThePathTracer) {
     // Single scattering: no photons, the connections carry all the light
     // of the point light over the ball to the milk and below it.
-    const std::string point = "lights=[" + pointLight("[0, 2.6, 0]", "23") + "]";
+    const std::string point = "lights=[" + pointLightJson("[0, 2.6, 0]", "23") + "]";
     std::vector<std::string> o = globeOfMilk(point.c_str());
     o[2] = "render.max_depth=1";
     std::vector<std::string> guided = o;
@@ -295,14 +295,14 @@ TEST(SphereCausticRenders, GuidedMarcherConnectsThroughAGlobeOfMilkLikeThePathTr
     const auto scene = buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), guided));
     EXPECT_TRUE(scene->deltaLightCaustics);
     EXPECT_FALSE(illuminationRequest(*scene, Method::Guided, {}).indirect);
-    expectPairedAgreement(renderWith("scenes/fig4_caustic.json", o, true),
-                          renderWith("scenes/fig4_caustic.json", guided, true), "guided, a globe of milk");
+    expectPairedAgreement(renderWithCaustics("scenes/fig4_caustic.json", o, true),
+                          renderWithCaustics("scenes/fig4_caustic.json", guided, true), "guided, a globe of milk");
 }
 
 TEST(SphereCaustics, ConnectedPhotonsInAndBelowAGlobeOfMilkCameAcrossOrThroughIt) {
     // Photon::Connected in the milk: straight from the light across the
     // ball's surface; below it: straight through the ball and its milk.
-    const std::string point = "lights=[" + pointLight("[0, 2.6, 0]", "23") + "]";
+    const std::string point = "lights=[" + pointLightJson("[0, 2.6, 0]", "23") + "]";
     const auto scene = buildScene(loadSceneFile(samplePath("scenes/fig4_caustic.json"), globeOfMilk(point.c_str())));
     ASSERT_TRUE(scene->deltaLightCaustics);
     const GlassSphere& ball = scene->glassSpheres.at(0);
@@ -341,7 +341,7 @@ TEST(SphereCausticRenders, ACollimatedBeamHoldingTheBallAddsTheSunsCaustic) {
     quad.push_back(R"(lights=[{"type": "collimated_quad", "center": [-0.6, 3.1, -0.24], "u": [1.4, 0.35, 0],
                                "v": [0, 0.14, 1.4], "direction": [0.25, -1, 0.1], "irradiance": [3, 2.9, 2.7]}])");
     auto added = [](const std::vector<std::string>& o) {
-        Image on = renderWith("scenes/fig4_caustic.json", o, true);
+        Image on = renderWithCaustics("scenes/fig4_caustic.json", o, true);
         const Image off = pathsAlone("scenes/fig4_caustic.json", o);
         for (size_t i = 0; i < on.rgba.size(); ++i) on.rgba[i] -= off.rgba[i];
         return on;
@@ -376,8 +376,8 @@ TEST(SphereCausticRenders, TheSunsCausticAgreesWithThePhotonsOfTheMarcher) {
         return m.mean();
     };
     const double off = mean(pathsAlone("scenes/fig4_caustic.json", o));
-    const double byConnections = mean(renderWith("scenes/fig4_caustic.json", o, true)) - off;
-    const double byPhotons = mean(renderWith("scenes/fig4_caustic.json", marcher, false)) - off;
+    const double byConnections = mean(renderWithCaustics("scenes/fig4_caustic.json", o, true)) - off;
+    const double byPhotons = mean(renderWithCaustics("scenes/fig4_caustic.json", marcher, false)) - off;
     EXPECT_GT(byPhotons, 0.03 * off);  // the caustic is a visible part of the image
     EXPECT_NEAR(byConnections, byPhotons, 0.06 * byPhotons)
         << "connections add " << byConnections << ", photons " << byPhotons << " to " << off;

@@ -6,6 +6,9 @@
 //  - A distance strategy drawing positions uniformly along the medium part
 //    of each segment towards a point light, weighed against the tracking
 //    collisions by MIS: the render agrees with tracking alone.
+//  - A surface strategy choosing reflection or refraction at glass with
+//    chance 1/2 each in place of the Fresnel choice: a furnace of glass in
+//    white fog stays at 1, with the reference path tracer and the marcher.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -106,6 +109,34 @@ private:
     const size_t mSlot;
 };
 
+// Reflection or refraction at glass with chance 1/2 each, weighted by the
+// Fresnel chance over 1/2: unbiased, with other variance than the Fresnel choice.
+class EvenGlassChoice final : public SurfaceStrategy {
+public:
+    EvenGlassChoice(const Scene&, size_t) {}
+    bool sample(ThreadContext& ctx, const SurfaceHit& hit, const Vec3& d, int region, const float u[3],
+                const SurfaceRequest&, Rng&, PathSurfaceEvent& out) const override {
+        const Scene& scene = ctx.scene;
+        if (scene.surfaces[size_t(hit.surface)].material.type != MaterialDesc::Type::Dielectric) return false;
+        const DielectricEvents both = dielectricEvents(scene, hit, d, region, TransportMode::Radiance);
+        const float F = both.reflectProbability;
+        const bool reflect = u[0] < 0.5f;
+        out.event = both.outcome[reflect ? 0 : 1];
+        out.weight = out.event.weight * (reflect ? 2 * F : 2 * (1 - F));
+        ++samples;
+        return true;
+    }
+    mutable std::atomic<long> samples{0};
+};
+
+// Every channel's pixel mean is 1 within 4 standard errors.
+void expectFurnaceAtOne(const Image& image, const std::string& label) {
+    for (int c = 0; c < 3; ++c) {
+        const auto s = pixelStats(image, c);
+        EXPECT_NEAR(s.mean, 1.0, 4 * s.stdError + 1e-6) << label << " channel " << c;
+    }
+}
+
 // Renders `scene` with its default strategies plus a Strategy(scene, slot);
 // `samples` is the plugged strategy's sample count.
 template <typename Strategy>
@@ -132,10 +163,7 @@ TEST(PluggedStrategies, AUniformDirectionMixtureKeepsTheFurnaceAtTheBackground) 
         const RenderResult r = renderPlugged<UniformDirections>(*scene, samples);
         EXPECT_GT(samples, 1000) << "the loop never asked the plugged strategy";
         EXPECT_EQ(r.counters.nonFiniteSamples, 0u);
-        for (int c = 0; c < 3; ++c) {
-            const auto s = pixelStats(r.image, c);
-            EXPECT_NEAR(s.mean, 1.0, 4 * s.stdError + 1e-6) << "sigma_s " << sigma << " channel " << c;
-        }
+        expectFurnaceAtOne(r.image, str("sigma_s ", sigma));
     }
 }
 
@@ -155,6 +183,19 @@ TEST(PluggedStrategies, AUniformDistanceSamplerAgreesWithTrackingAlone) {
     EXPECT_GT(samples, 1000) << "the loop never asked the plugged strategy";
     EXPECT_EQ(r.counters.nonFiniteSamples, 0u);
     test::expectPairedAgreement(plain.image, r.image, "uniform distances against tracking alone");
+}
+
+TEST(PluggedStrategies, AnEvenGlassChoiceKeepsAFurnaceOfGlassInFogAtTheBackground) {
+    // As GlassSplitting.AFurnaceOfGlassInWhiteFogStaysAtTheBackground, with
+    // glass splitting off so that the plugged strategy takes every glass event.
+    for (const char* method : {"reference", "guided"}) {
+        auto scene = test::glassInWhiteFog(method, false);
+        long samples = 0;
+        const RenderResult r = renderPlugged<EvenGlassChoice>(*scene, samples);
+        EXPECT_GT(samples, 1000) << "the loop never asked the plugged strategy";
+        EXPECT_EQ(r.counters.nonFiniteSamples, 0u);
+        expectFurnaceAtOne(r.image, method);
+    }
 }
 
 }  // namespace

@@ -31,9 +31,6 @@ RenderResult renderCloud(Method method, const std::vector<std::string>& extra) {
     return renderImage(*buildScene(loadSceneFile(samplePath("cloud.json"), overrides)));
 }
 
-bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
 
 class AovMethods : public ::testing::TestWithParam<Method> {};
 

@@ -48,9 +48,6 @@ RenderResult resumed(const Scene& scene, RenderOptions options, const RenderChec
     return renderImage(scene, options);
 }
 
-bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
 
 void expectSameRender(const RenderResult& a, const RenderResult& b, const std::string& what) {
     EXPECT_FALSE(b.interrupted) << what;

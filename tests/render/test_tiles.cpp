@@ -53,9 +53,6 @@ std::vector<float> cut(const std::vector<float>& frame, int frameWidth, const Pi
     return out;
 }
 
-bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
 
 class TileMethods : public ::testing::TestWithParam<Method> {};
 

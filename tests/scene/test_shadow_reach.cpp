@@ -32,7 +32,7 @@ std::unique_ptr<Scene> milkScene(const std::string& material, const std::string&
 }
 
 const std::string Glass = R"({"type": "dielectric", "ior": 1.5})";
-const std::string Outside = R"({"type": "sphere", "position": [0, 3, 0], "radius": 0.3, "power": [10, 10, 10]},
+const std::string LightOutside = R"({"type": "sphere", "position": [0, 3, 0], "radius": 0.3, "power": [10, 10, 10]},
     {"type": "point", "position": [2, 0, 0], "intensity": [1, 1, 1]},
     {"type": "directional", "direction": [0, -1, 0], "irradiance": [1, 1, 1]})";
 
@@ -78,7 +78,7 @@ int expectTableIsSound(const Scene& scene, int region) {
 }
 
 TEST(ShadowReach, LightsOutsideBendingGlassAreOutOfReachOfItsMedium) {
-    auto scene = milkScene(Glass, Outside);
+    auto scene = milkScene(Glass, LightOutside);
     EXPECT_EQ(expectTableIsSound(*scene, Milk), 4);  // three lights and the environment
     for (size_t i = 0; i <= scene->lights.size(); ++i) {
         EXPECT_TRUE(scene->shadowRaysCanReach(Scene::WorldRegion, i));
@@ -102,7 +102,7 @@ TEST(ShadowReach, LightsInsideOrAcrossTheGlassStayInReach) {
 TEST(ShadowReach, SurfacesThatLetShadowRaysThroughSealNothing) {
     for (const std::string& m : {std::string(R"({"type": "interface"})"),
                                  std::string(R"({"type": "dielectric", "ior": 1})")}) {
-        auto scene = milkScene(m, Outside);
+        auto scene = milkScene(m, LightOutside);
         EXPECT_EQ(expectTableIsSound(*scene, Milk), 0) << m;
         EXPECT_GT(raysThrough(*scene, Milk, 1), 0) << m;
     }
@@ -114,7 +114,7 @@ TEST(ShadowReach, AnOpenMeshSealsNothing) {
     const std::string obj = dir.write("open_box.obj", "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
                    "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 4 1 5\nf 4 5 8\n");
     setWarningsQuiet(true);
-    auto scene = milkScene(Glass, Outside, str(R"("shape": "mesh", "file": ")", obj, R"(")"));
+    auto scene = milkScene(Glass, LightOutside, str(R"("shape": "mesh", "file": ")", obj, R"(")"));
     setWarningsQuiet(false);
     EXPECT_EQ(expectTableIsSound(*scene, Milk), 0);
     EXPECT_GT(raysThrough(*scene, Milk, 0), 0);  // the sphere light above the open top

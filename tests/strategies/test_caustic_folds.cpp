@@ -18,9 +18,8 @@ namespace vdbmarch {
 namespace {
 
 // The paper's figure 4: a point light 1.85 over a ball of radius 0.45.
-GlassSphere ball() { return test::figure4Ball(); }
 
-std::unique_ptr<Light> pointLight() {
+std::unique_ptr<Light> foldsPointLight() {
     LightDesc d;
     d.type = LightDesc::Type::Point;
     d.position = Vec3(0.f, 2.6f, 0.f);
@@ -66,8 +65,8 @@ double connectedLight(const GlassSphere& s, const Light& l, const Vec3& x, int* 
 }
 
 TEST(CausticFolds, TwoConnectionsAppearAcrossTheFold) {
-    const GlassSphere s = ball();
-    for (const auto& light : {pointLight(), sun()}) {
+    const GlassSphere s = test::figure4Ball();
+    for (const auto& light : {foldsPointLight(), sun()}) {
         const Light& l = *light;
         CausticFold f;
         ASSERT_TRUE(causticFold(s, l, f));
@@ -94,8 +93,8 @@ TEST(CausticFolds, RaysCrossTheFoldWhereTheConnectionsMerge) {
     // Along a ray through the fold, the point where the number of
     // connections changes by two, found by bisection with the solver alone,
     // is the crossing foldCrossings finds.
-    const GlassSphere s = ball();
-    for (const auto& light : {pointLight(), sun()}) {
+    const GlassSphere s = test::figure4Ball();
+    for (const auto& light : {foldsPointLight(), sun()}) {
         const Light& l = *light;
         CausticFold f;
         ASSERT_TRUE(causticFold(s, l, f));
@@ -147,7 +146,7 @@ TEST(CausticFolds, RaysCrossTheFoldWhereTheConnectionsMerge) {
 }
 
 TEST(CausticFolds, NoFoldForALightInsideTheBall) {
-    const GlassSphere s = ball();
+    const GlassSphere s = test::figure4Ball();
     LightDesc d;
     d.type = LightDesc::Type::Point;
     d.position = s.center + Vec3(0.1f, 0.f, 0.f);

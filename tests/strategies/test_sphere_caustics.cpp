@@ -17,7 +17,6 @@
 namespace vdbmarch {
 namespace {
 
-GlassSphere ball() { return test::figure4Ball(); }
 
 // Distance from y to the exit ray of the connection.
 double missDistance(const SphereConnection& c, const Vec3& y) {
@@ -35,7 +34,7 @@ bool leavesAlong(const SphereConnection* c, int n, const Vec3& w) {
 }
 
 TEST(SphereCaustics, EveryConnectionPassesThroughItsEndPoint) {
-    const GlassSphere s = ball();
+    const GlassSphere s = test::figure4Ball();
     Rng rng(7);
     int found = 0, multiple = 0;
     for (int i = 0; i < 2000; ++i) {
@@ -66,7 +65,7 @@ TEST(SphereCaustics, EveryConnectionPassesThroughItsEndPoint) {
 // lens's axis, where the rays through its middle cross in pairs closer than
 // the solver's grid, and near the folds of the caustic.
 TEST(SphereCaustics, TheSolverFindsEveryTracedPathFromAPoint) {
-    const GlassSphere s = ball();
+    const GlassSphere s = test::figure4Ball();
     const Vec3 y(0.f, 2.6f, 0.f);
     Rng rng(3);
     int tried = 0, missed = 0;
@@ -150,7 +149,7 @@ void expectConnectionsMatchBruteForce(const GlassSphere& s, const Vec3& x, const
 
 TEST(SphereCaustics, ConnectionEstimateMatchesBruteForceTracing) {
     for (const Vec3 x : {Vec3(0.f, -0.3f, 0.f), Vec3(0.12f, -0.1f, 0.05f), Vec3(0.3f, 0.1f, -0.2f)})
-        expectConnectionsMatchBruteForce(ball(), x, Vec3(0.f, 2.6f, 0.f), 0.1f, false, 11);
+        expectConnectionsMatchBruteForce(test::figure4Ball(), x, Vec3(0.f, 2.6f, 0.f), 0.1f, false, 11);
 }
 
 // A point inside the ball (within 0.9 of its radius) and one outside it.
@@ -162,7 +161,7 @@ Vec3 outsidePoint(Rng& rng) {
 }
 
 TEST(SphereCaustics, EveryConnectionAcrossTheSurfacePassesThroughItsEndPoint) {
-    const GlassSphere s = ball();
+    const GlassSphere s = test::figure4Ball();
     Rng rng(5);
     for (const bool fromInside : {false, true}) {
         int tried = 0, found = 0, foundThorough = 0;
@@ -224,7 +223,7 @@ bool pointAlong(const GlassSphere& s, const SphereConnection& t, bool outside, R
 // Paths traced across the surface from a point (inside the ball, or
 // outside it), then found again from points along them on the other side.
 TEST(SphereCaustics, TheSolverFindsEveryTracedPathAcrossTheSurface) {
-    const GlassSphere s = ball();
+    const GlassSphere s = test::figure4Ball();
     for (const Vec3 y : {Vec3(0.1f, 0.8f, -0.05f), s.center, Vec3(0.f, 2.6f, 0.f), Vec3(0.6f, 0.2f, 0.3f)}) {
         const bool yInside = length(y - s.center) < s.radius;
         Rng rng(9);
@@ -265,13 +264,13 @@ TEST(SphereCaustics, ConnectionAcrossTheSurfaceMatchesBruteForceTracing) {
                           {Vec3(0.7f, 0.9f, 0.4f), Vec3(-0.05f, 0.7f, 0.f), 0.1f},
                           {Vec3(0.1f, 0.6f, 0.1f), Vec3(0.f, 2.6f, 0.f), 0.3f},
                           {Vec3(-0.2f, 0.9f, 0.f), Vec3(1.2f, 0.4f, 0.3f), 0.2f}};
-    for (const Case& cs : cases) expectConnectionsMatchBruteForce(ball(), cs.x, cs.lightC, cs.rl, true, 13);
+    for (const Case& cs : cases) expectConnectionsMatchBruteForce(test::figure4Ball(), cs.x, cs.lightC, cs.rl, true, 13);
 }
 
 // A light at infinity (directional, collimated): its parallel rays traced
 // into the ball, through it or into it, found again from points along them.
 TEST(SphereCaustics, TheSolverFindsEveryParallelRayThroughOrIntoTheBall) {
-    const GlassSphere s = ball();
+    const GlassSphere s = test::figure4Ball();
     for (const Vec3 wL : {normalize(Vec3(0.3f, 1.f, -0.2f)), Vec3(0.f, 1.f, 0.f), normalize(Vec3(1.f, 0.1f, 0.f))}) {
         const Vec3 a = normalize(cross(wL, Vec3(0.3f, 0.1f, 1.f))), b = cross(wL, a);
         Rng rng(17);
@@ -309,7 +308,7 @@ TEST(SphereCaustics, TheSolverFindsEveryParallelRayThroughOrIntoTheBall) {
 // in a cone of 0.1 rad around the connection, which must hold every one
 // counted); the connection brings (1 - F...) / J.
 TEST(SphereCaustics, ParallelConnectionsMatchBruteForceTracing) {
-    const GlassSphere s = ball();
+    const GlassSphere s = test::figure4Ball();
     const Vec3 wL = normalize(Vec3(0.2f, 1.f, 0.1f));
     const double cosAccept = std::cos(0.01), omegaAccept = 2 * double(Pi) * (1 - cosAccept);
     const float cosSample = std::cos(0.1f);

@@ -247,6 +247,10 @@ bool allFinite(const Image& img) {
     return true;
 }
 
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
 float maxAlpha(const Image& img) {
     float a = 0;
     for (int y = 0; y < img.height; ++y)
@@ -545,6 +549,19 @@ GlassSphere figure4Ball() {
     s.radius = 0.45f;
     s.ior = 1.5f;
     return s;
+}
+
+std::unique_ptr<Scene> glassInWhiteFog(const std::string& method, bool glassSplitting) {
+    return sceneFromJson(str(R"({"camera": {"position": [0.3, 0.4, 4], "look_at": [0, 0, 0], "fov_deg": 45,
+        "resolution": [16, 16]},
+        "media": [{"name": "fog", "type": "homogeneous", "sigma_a": 0, "sigma_s": 0.8,
+                   "bounds": {"min": [-2, -2, -2], "max": [2, 2, 2]}}],
+        "surfaces": [{"shape": "sphere", "transform": {"scale": [1, 0.7, 0.9]}, "material": {"type": "dielectric", "ior": 1.5}},
+                     {"shape": "box", "transform": {"scale": 0.8, "rotate": [1, 1, 0, 30], "translate": [0.6, 0.3, 1]},
+                      "material": {"type": "dielectric", "ior": 2.4}}],
+        "background": [1, 1, 1], "photons": {"count": 20000},
+        "render": {"method": ")", method, R"(", "spp": 64, "max_depth": 1000, "max_surface_bounces": 1000, "seed": 5},
+        "experiments": {"glass_splitting": )", glassSplitting ? "true" : "false", "}}"));
 }
 
 }  // namespace vdbmarch::test

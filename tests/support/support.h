@@ -160,6 +160,11 @@ void writeIcosahedron(const std::string& path);
 // radius 0.45 at (0, 0.75, 0), n = 1.5.
 GlassSphere figure4Ball();
 
+// A furnace: a uniform background of radiance 1 and white fog (albedo 1)
+// around two lossless glass objects (a sphere, ior 1.5; a box, ior 2.4),
+// 16x16 at 64 spp with `method`; every pixel's expectation is 1.
+std::unique_ptr<Scene> glassInWhiteFog(const std::string& method, bool glassSplitting);
+
 // ---------------------------------------------------------------------------
 // Statistics
 
@@ -233,6 +238,8 @@ std::vector<std::string> cloudSkyWithLightsAndGlass();
 // Images
 
 bool allFinite(const Image& img);
+// True when the two hold the same floats, bit for bit.
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b);
 float maxAlpha(const Image& img);
 // Every pixel shows exactly `bg` with alpha 0 (nothing in front of it).
 void expectBackgroundEverywhere(const Image& img, const Color& bg, float tol = 1e-6f);
