@@ -19,7 +19,7 @@ namespace vdbmarch {
 class PhotonEmitter {
 public:
     PhotonEmitter() = default;
-    // Light::photonEmission: per kind of light, scene/lights/*_light.h.
+    // Light::photonEmission: per kind of light, scene/lights/light_kinds.h.
     static PhotonEmitter forLight(const Light& light, const PhotonTarget& target);
     // Constant environment radiance (the background), as seen from the
     // target: uniform direction, uniform on a disc perpendicular to it that

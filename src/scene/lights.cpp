@@ -1,10 +1,7 @@
 #include "scene/lights.h"
 
-#include "scene/lights/collimated_quad_light.h"
-#include "scene/lights/directional_light.h"
-#include "scene/lights/point_light.h"
-#include "scene/lights/sphere_light.h"
-#include "scene/lights/spot_light.h"
+#include "scene/lights/light_kinds.h"
+
 
 namespace vdbmarch {
 

@@ -28,7 +28,7 @@ struct LightSample {
 };
 
 // A spot light's cone (Light::spotCone), with its falloff's cosines as
-// spotFalloff (scene/lights/spot_light.h) takes them.
+// spotFalloff (scene/lights/light_kinds.h) takes them.
 struct SpotCone {
     Vec3 apex, axis;  // the light's position and unit direction
     float coneDeg = 30, falloffDeg = 5;
@@ -93,7 +93,12 @@ public:
     // position (radius 0), a sphere light's sphere. False elsewhere (the
     // light may then be anywhere: a shadow ray from inside closed surfaces
     // may reach it).
-    virtual bool emittingBall(Vec3& center, float& radius) const { return false; }
+    bool emittingBall(Vec3& center, float& radius) const {
+        if (!(mBallRadius >= 0)) return false;
+        center = mBallCenter;
+        radius = mBallRadius;
+        return true;
+    }
 
     // --- One kind's geometry, for the strategies built on it (null for other kinds)
     virtual const SpotCone* spotCone() const { return nullptr; }
@@ -107,8 +112,17 @@ protected:
     explicit Light(const LightDesc& d) : mDesc(d) {}
     // photonEmission before its common checks (an empty target, no power).
     virtual std::unique_ptr<LightEmission> emissionTowards(const PhotonTarget& target) const = 0;
+    // Sets emittingBall's answer (a kind that sets none answers false).
+    void setEmittingBall(const Vec3& center, float radius) {
+        mBallCenter = center;
+        mBallRadius = radius;
+    }
 
     LightDesc mDesc;
+
+private:
+    Vec3 mBallCenter{0, 0, 0};
+    float mBallRadius = -1;  // < 0: no ball
 };
 
 // The light a description asks for.

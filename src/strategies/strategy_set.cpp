@@ -8,6 +8,15 @@
 
 namespace vdbmarch {
 
+namespace {
+// Appends an owned strategy to its kind's list, in the order loops iterate.
+template <typename S>
+void addTo(std::vector<const S*>& list, std::vector<std::unique_ptr<S>>& owned, std::unique_ptr<S> s) {
+    list.push_back(s.get());
+    owned.push_back(std::move(s));
+}
+}  // namespace
+
 StrategySet::StrategySet() = default;
 StrategySet::~StrategySet() = default;
 
@@ -26,26 +35,10 @@ std::shared_ptr<StrategySet> StrategySet::build(const Scene& scene) {
     return set;
 }
 
-void StrategySet::add(std::unique_ptr<DistanceStrategy> s) {
-    mDistances.push_back(s.get());
-    mOwnedDistances.push_back(std::move(s));
-}
-
-void StrategySet::add(std::unique_ptr<DirectionStrategy> s) {
-    mDirections.push_back(s.get());
-    mOwnedDirections.push_back(std::move(s));
-}
-
-void StrategySet::add(std::unique_ptr<ConnectionStrategy> s) {
-    mConnections.push_back(s.get());
-    mOwnedConnections.push_back(std::move(s));
-}
-
-void StrategySet::add(std::unique_ptr<SurfaceStrategy> s) {
-    mSurfaces.push_back(s.get());
-    mOwnedSurfaces.push_back(std::move(s));
-}
-
+void StrategySet::add(std::unique_ptr<DistanceStrategy> s) { addTo(mDistances, mOwnedDistances, std::move(s)); }
+void StrategySet::add(std::unique_ptr<DirectionStrategy> s) { addTo(mDirections, mOwnedDirections, std::move(s)); }
+void StrategySet::add(std::unique_ptr<ConnectionStrategy> s) { addTo(mConnections, mOwnedConnections, std::move(s)); }
+void StrategySet::add(std::unique_ptr<SurfaceStrategy> s) { addTo(mSurfaces, mOwnedSurfaces, std::move(s)); }
 Color StrategySet::connect(ThreadContext& ctx, int region, const ScatterVertex& v, Rng& rng,
                            const ConnectionRequest& request, bool& connected) const {
     Color L(0);

@@ -1,4 +1,4 @@
-#include "scene/lights/collimated_quad_light.h"
+#include "scene/lights/light_kinds.h"
 
 #include <algorithm>
 #include <cmath>

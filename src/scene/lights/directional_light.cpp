@@ -1,4 +1,4 @@
-#include "scene/lights/directional_light.h"
+#include "scene/lights/light_kinds.h"
 
 namespace vdbmarch {
 

@@ -1,4 +1,4 @@
-#include "scene/lights/point_light.h"
+#include "scene/lights/light_kinds.h"
 
 #include <cmath>
 

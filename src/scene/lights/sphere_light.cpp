@@ -1,4 +1,4 @@
-#include "scene/lights/sphere_light.h"
+#include "scene/lights/light_kinds.h"
 
 #include <cmath>
 
@@ -8,6 +8,7 @@ namespace vdbmarch {
 
 SphereLight::SphereLight(const LightDesc& d) : Light(d) {
     mSphere = {d.position, d.radius};
+    setEmittingBall(mSphere.center, mSphere.radius);
     mRadiance = d.power / (4 * Pi * Pi * d.radius * d.radius);
 }
 

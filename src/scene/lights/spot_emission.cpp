@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "scene/lights/spot_light.h"
+#include "scene/lights/light_kinds.h"
 
 namespace vdbmarch {
 

@@ -1,12 +1,12 @@
-#include "scene/lights/spot_light.h"
+#include "scene/lights/light_kinds.h"
 
 #include <cmath>
 
-#include "scene/lights/point_light.h"
 
 namespace vdbmarch {
 
 SpotLight::SpotLight(const LightDesc& d) : Light(d) {
+    setEmittingBall(d.position, 0);
     mCone.apex = d.position;
     mCone.axis = d.direction;
     mCone.coneDeg = d.coneDeg;
