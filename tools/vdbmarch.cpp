@@ -104,6 +104,9 @@ int main(int argc, char** argv) {
     compare->add_flag("--identical", ca.identical,
                       "Only check bit-identity of every channel of every pixel (and the windows): exit 0 if "
                       "identical, 1 if not");
+    compare->add_flag("--paired", ca.paired,
+                      "Check that two renders whose random numbers differ agree: the mean per-pixel difference over "
+                      "the image and each quadrant, per channel, within 4 standard errors (exit 0), or not (exit 1)");
 
     MergeArgs ma;
     CLI::App* merge = app.add_subcommand(

@@ -14,6 +14,9 @@ struct CompareArgs {
     // Measure this layer of the test image (R, G, B, and A where it has
     // one) instead of its RGBA: `noisy`, the raw beauty of a denoised render.
     std::string layer;
+    // Report pairedAgreement (image/metrics.h) and exit 1 when some region
+    // and channel differ by more than 4 standard errors.
+    bool paired = false;
 };
 
 int runCompare(const CompareArgs& args);

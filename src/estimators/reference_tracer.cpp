@@ -45,7 +45,7 @@ public:
         const int region = regionAtRayStart(mScene, cameraRay);
         const PathState start;
         if (!mChromatic) return mPaths.trace(ctx, cameraRay, region, -1, rng, start);
-        PathRadiance out{Color(0), 0.f, Color(0), Color(0)};
+        PathRadiance out{Color(0), 0.f, Color(0), Color(0), FirstEvent{}};
         for (int c = 0; c < 3; ++c) {
             PathRadiance p = mPaths.trace(ctx, cameraRay, region, c, rng, start);
             out.L[c] = p.L[c];

@@ -116,6 +116,7 @@ private:
         bool infiniteTail;
         if (!activeIntervals(ctx, region, ray, tEnd, infiniteTail)) return true;
         MarcherScratch& m = scratch(ctx);
+        const bool scatter = scatters(ctx);  // else emission and transmittance only
         auto& steps = m.pdfSteps;
         steps.clear();
         m.stepSigmaS.clear();
@@ -165,7 +166,8 @@ private:
                         L += beta * T * st.absorbedA * mp.emission;
                         tallyEmission(ctx, beta * T * st.absorbedA * mp.emission);
                     }
-                    const float base = mp.scatters() ? average(T * st.absorbedS) : 0.f;  // sigma_s T(t0) S(kappa, len)
+                    // sigma_s T(t0) S(kappa, len)
+                    const float base = scatter && mp.scatters() ? average(T * st.absorbedS) : 0.f;
                     if (base > 0) {
                         steps.push_back({float(a), len, average(mp.sigma_t), base});
                         m.stepSigmaS.push_back(mp.sigma_s);

@@ -8,13 +8,18 @@
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
 #include "transport/tracking.h"
+#include "transport/transmittance.h"
 
 namespace vdbmarch {
 
 SegmentMarcher::SegmentMarcher(const EstimatorInputs& in)
     : mScene(in.scene), mIllumination(in.illumination), mChromatic(hasChromaticExtinction(in.scene)),
       mTallyDirect(in.scene.desc.render.aovs.splitDirect()),
-      mPaths(in.scene, in.strategies, PathOptions{mIllumination && mIllumination->pointLightsByPhotons, nullptr}) {
+      mPaths(in.scene, in.strategies, PathOptions{mIllumination && mIllumination->pointLightsByPhotons, nullptr}),
+      // The camera path's vertices are on surfaces, where no photons are
+      // gathered: next-event estimation there takes every light. Roulette
+      // only ends paths of negligible throughput (they march every segment).
+      mCameraPaths(in.scene, in.strategies, PathOptions{false, nullptr, this, 0, RouletteThreshold}) {
     const Scene& scene = in.scene;
     // Without emissive media or refracting glass, the light arriving at a
     // sample straight from its first direction is what next-event estimation
@@ -22,125 +27,36 @@ SegmentMarcher::SegmentMarcher(const EstimatorInputs& in)
     mLastEventByNextEvent = !hasBendingGlass(scene);
     for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
+    for (const Region& r : scene.regions) {
+        bool emits = false;
+        for (int m : r.media) emits = emits || scene.media[size_t(m)]->hasEmission;
+        mRegionEmits.push_back(emits);
+    }
 }
 
+// The marchers' tallies of the direct and emitted parts (tallyEmission,
+// tallyInScattered) join what the loop counts at surfaces and lights.
 PathRadiance SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
+    ++ctx.counters.cameraRays;
     MarcherScratch& m = scratch(ctx);
     m.direct = Color(0);
     m.emitted = Color(0);
-    PathRadiance r = trace(cameraRay, rng, ctx);
-    if (mTallyDirect) r.direct = m.direct;
-    r.emitted = m.emitted;
+    PathRadiance r = mCameraPaths.trace(ctx, cameraRay, regionAtRayStart(mScene, cameraRay), -1, rng, PathState{});
+    r.direct = mTallyDirect ? r.direct + m.direct : Color(0);
+    r.emitted += m.emitted;
     return r;
 }
 
-// Scattering orders of the contributions (the direct AOV): lights and the
-// background seen after at most one diffuse bounce, emission before the
-// second, a surface's next-event estimate at the first bounce, and what
-// inScattered() counts as direct at a march sample before the first bounce.
-PathRadiance SegmentMarcher::trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const {
-    ++ctx.counters.cameraRays;
-    CameraPath path;
-    path.region = regionAtRayStart(mScene, cameraRay);
-    return traceFrom(cameraRay, path, rng, ctx);
-}
-
-PathRadiance SegmentMarcher::traceFrom(Ray ray, CameraPath path, Rng& rng, ThreadContext& ctx) const {
-    const Scene& scene = mScene;
-    Color L(0);
-    Color& beta = path.beta;
-    int& region = path.region;
-    // The background seen in glass reflections that were counted whole
-    // (mirroredLight): part of what the camera sees through.
-    float mirroredThrough = 0;
-    auto done = [&](float transmittance) {
-        return PathRadiance{L, transmittance + mirroredThrough, Color(0), Color(0)};
-    };
-    for (;; ++path.bounce) {
-        const RaySegment seg = nextRaySegment(scene, ray);
-        const SurfaceHit& h = seg.surface;
-        const bool hit = seg.hitSurface;
-        const int light = seg.light;
-        const float segEnd = seg.tEnd;
-        scratch(ctx).pathDepth = path.diffuseBounces;
-        if (!marchSegment(ctx, region, ray, segEnd, rng, L, beta)) return done(0.f);
-        auto addSeen = [&](const Color& Le) {
-            L += Le;
-            if (mTallyDirect && path.diffuseBounces <= 1) scratch(ctx).direct += Le;
-        };
-        const bool seen = !path.lightsCounted && !path.mirrorCounted;
-        if (light >= 0) {
-            if (seen) {
-                const Color Le = beta * scene.lights[size_t(light)].emittedRadiance();
-                addSeen(Le);
-                if (path.diffuseBounces == 0) scratch(ctx).emitted += Le;
-            }
-            return done(0.f);
-        }
-        if (!hit) {
-            // The camera path seen straight (or through glass): the map as a backdrop.
-            if (seen)
-                addSeen(beta * (path.diffuseBounces == 0 ? scene.environment.radianceSeen(ray.d)
-                                                          : scene.environment.radiance(ray.d)));
-            return done(path.diffuseBounces > 0 ? 0.f : average(beta));  // a diffuse surface is opaque
-        }
-        ++ctx.counters.surfaceHits;
-        if (path.bounce >= scene.desc.render.maxSurfaceBounces) return done(0.f);
-        const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
-        // A surface strategy may split the camera path at glass, or count
-        // the light its reflection sees (strategies/glass_splitting.h).
-        const SurfaceRequest request{path.diffuseBounces == 0 && path.glassSplits < SplitDielectricEvents,
-                                     path.diffuseBounces == 0};
-        const PathSurfaceEvent pe = mPaths.strategies().surfaceEvent(ctx, h, ray.d, region, u, request, rng);
-        addSeen(beta * pe.light);
-        if (path.diffuseBounces == 0) mirroredThrough += average(beta) * pe.backgroundSeen;
-        path.mirrorCounted = pe.mirrorCounted;
-        const SurfaceEvent& e = pe.event;
-        const Color& weight = pe.weight;
-        if (pe.split) {
-            // Both outcomes: the reflection, then the refraction.
-            ++path.glassSplits;
-            CameraPath reflected = path;
-            reflected.beta = beta * pe.mirrorWeight;
-            reflected.region = pe.mirror.region;
-            reflected.lightsCounted = false;
-            ++reflected.bounce;
-            const PathRadiance r = traceFrom(pe.mirror.ray, reflected, rng, ctx);
-            beta *= weight;
-            if (!e.straight) path.lightsCounted = false;
-            ++path.bounce;
-            region = e.region;
-            const PathRadiance t = traceFrom(e.ray, path, rng, ctx);
-            return {L + r.L + t.L, mirroredThrough + r.transmittance + t.transmittance, Color(0), Color(0)};
-        }
-        if (e.kind == SurfaceEvent::Kind::Diffuse) {
-            const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
-            const ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
-            Color Ld = beta * directLight(ctx, region, vertex, rng, {});
-            // Light through specular surfaces (the connection strategies):
-            // point and spot lights, which no path finds; sphere lights too
-            // where max_depth ends the path here, else the path below finds them.
-            const bool last = path.diffuseBounces + 1 >= scene.desc.render.maxDepth;
-            bool connected;
-            const Color Lc = mPaths.strategies().connect(ctx, region, vertex, rng, {last, true, !last}, connected);
-            if (connected) Ld += beta * Lc;
-            L += Ld;
-            if (mTallyDirect && path.diffuseBounces == 0) scratch(ctx).direct += Ld;
-            // Light that reaches the surface after scattering in a medium
-            // (what shadow rays miss): continue the path in the cosine-
-            // sampled direction, marching the media it crosses, as a
-            // scattering event of max_depth; lights were counted above.
-            if (++path.diffuseBounces >= scene.desc.render.maxDepth) return done(0.f);
-            beta *= weight;
-            if (!russianRoulette(beta, rng)) return done(0.f);
-            path.lightsCounted = true;
-        } else {
-            beta *= weight;
-            if (!e.straight) path.lightsCounted = false;  // shadow rays cannot follow a reflected or bent path
-        }
-        ray = e.ray;
-        region = e.region;
+bool SegmentMarcher::march(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int depth, Rng& rng, Color& L,
+                           Color& beta) const {
+    scratch(ctx).pathDepth = depth;
+    // Past max_depth a march adds emission only: where the region emits
+    // none, the path needs just the segment's transmittance.
+    if (!scatters(ctx) && !mRegionEmits[size_t(region)]) {
+        beta *= regionTransmittance(ctx, region, ray, tEnd, rng);
+        return true;
     }
+    return marchSegment(ctx, region, ray, tEnd, rng, L, beta);
 }
 
 CacheLookup& MarcherScratch::lookup(const RadianceCache& cache) {
@@ -155,7 +71,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     MarcherScratch& m = scratch(ctx);
     if (mTallyDirect) m.liDirect = Color(0);
     const bool tallyHere = mTallyDirect && m.pathDepth == 0;
-    if (!mp.scatters()) return Color(0);
+    if (!mp.scatters() || !scatters(ctx)) return Color(0);
     ++ctx.counters.liSamples;
     const Illumination& il = *mIllumination;
     if (il.li == LiSource::Cache) {

@@ -1,9 +1,7 @@
-// The camera-path loop the three ray marchers share: surfaces (the shared
-// surface event: glass refracts the camera ray into the medium it holds,
-// interfaces switch regions, diffuse surfaces add direct light and continue
-// the path by a cosine bounce), sphere lights and the background, with a
-// marcher-specific march of each segment between surfaces; and the one L_i
-// estimate all of them use at their samples, so that comparisons are fair.
+// What the three ray marchers share: their camera paths run the one path
+// loop (paths/path_tracer.h) with media crossed by a march of each segment
+// (SegmentMarch, the marcher's own), and the one L_i estimate all of them
+// use at their samples, so that comparisons are fair.
 #pragma once
 
 #include <memory>
@@ -50,34 +48,18 @@ struct MarcherScratch final : ThreadContextExtension {
     CacheLookup& lookup(const RadianceCache& cache);
 };
 
-class SegmentMarcher : public Estimator {
+class SegmentMarcher : public Estimator, public SegmentMarch {
 public:
     explicit SegmentMarcher(const EstimatorInputs& in);
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override;
-
-private:
-    // Where a camera path stands in the loop of traceFrom.
-    struct CameraPath {
-        Color beta{1, 1, 1};
-        int region = 0;
-        int bounce = 0;           // surfaces met
-        int diffuseBounces = 0;
-        int glassSplits = 0;      // glass events whose two outcomes it follows (SplitDielectricEvents)
-        // After a diffuse bounce, lights and the background were already
-        // counted by the surface's shadow rays, unless glass bent the path since.
-        bool lightsCounted = false;
-        // The light or background the last glass reflection's ray meets was
-        // counted at the glass (mirroredLight).
-        bool mirrorCounted = false;
-    };
-    PathRadiance trace(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const;
-    PathRadiance traceFrom(Ray ray, CameraPath path, Rng& rng, ThreadContext& ctx) const;
+    bool march(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int depth, Rng& rng, Color& L,
+               Color& beta) const override;
 
 protected:
     // Marches [0, tEnd) of the ray in `region`, adding to L and attenuating
     // beta. Returns false when Russian roulette ended the path. With
     // mTallyDirect it also adds L's direct part by tallyEmission and
-    // tallyInScattered.
+    // tallyInScattered. Past max_depth (!scatters(ctx)) emission only.
     virtual bool marchSegment(ThreadContext& ctx, int region, const Ray& ray, float tEnd, Rng& rng, Color& L,
                               Color& beta) const = 0;
 
@@ -112,6 +94,9 @@ protected:
     }
     void tallyInScattered(ThreadContext& ctx, const Color& weight) const { scratch(ctx).direct += weight * scratch(ctx).liDirect; }
     void applyInfiniteTail(int region, Color& beta) const;
+    // Whether march samples of the current segment are scattering events
+    // max_depth allows (MarcherScratch::pathDepth).
+    bool scatters(ThreadContext& ctx) const { return scratch(ctx).pathDepth < mScene.desc.render.maxDepth; }
 
     static MarcherScratch& scratch(ThreadContext& ctx) { return ctx.extensionAs<MarcherScratch>(); }
     CacheLookup& cacheLookup(ThreadContext& ctx) const { return scratch(ctx).lookup(*mIllumination->cache); }
@@ -121,7 +106,9 @@ protected:
     const bool mChromatic;  // continuation paths track one channel
     const bool mTallyDirect;  // render.aovs asks for direct or indirect
     bool mLastEventByNextEvent = true;  // see the constructor
+    std::vector<char> mRegionEmits;  // per region: some medium in it emits
     PathTracer mPaths;  // continuation paths, with the render's strategies
+    PathTracer mCameraPaths;  // camera paths, marched by this
 };
 
 // One step of length dx in a medium with extinction kappa: its transmittance,

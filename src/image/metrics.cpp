@@ -119,6 +119,37 @@ RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, fl
     return s;
 }
 
+PairedAgreement pairedAgreement(const Image& test, const Image& reference) {
+    checkSameSize(test, reference);
+    PairedAgreement out;
+    const int W = reference.width, H = reference.height;
+    for (int q = 0; q < PairedAgreement::Regions; ++q) {
+        const int x0 = q == 0 ? 0 : ((q - 1) % 2) * (W / 2), y0 = q == 0 ? 0 : ((q - 1) / 2) * (H / 2);
+        const int w = q == 0 ? W : (q - 1) % 2 ? W - W / 2 : W / 2, h = q == 0 ? H : (q - 1) / 2 ? H - H / 2 : H / 2;
+        for (int c = 0; c < PairedAgreement::Channels; ++c) {
+            double sum = 0, sum2 = 0;
+            size_t n = 0;
+            for (int y = y0; y < y0 + h; ++y)
+                for (int x = x0; x < x0 + w; ++x) {
+                    const size_t i = 4 * (size_t(y) * size_t(W) + size_t(x));
+                    const double d = double(test.rgba[i + size_t(c)]) - double(reference.rgba[i + size_t(c)]);
+                    if (!std::isfinite(d)) continue;
+                    sum += d;
+                    sum2 += d * d;
+                    ++n;
+                }
+            if (n < 2) continue;
+            const double mean = sum / double(n);
+            const double var = std::max(0.0, (sum2 - sum * mean) / double(n - 1));
+            const double se = std::sqrt(var / double(n));
+            const double z = se > 0 ? mean / se : 0.0;
+            out.z[q][c] = z;
+            if (std::abs(z) > out.maxAbsZ) out.maxAbsZ = std::abs(z), out.region = q, out.channel = c;
+        }
+    }
+    return out;
+}
+
 double lowFrequencyError(const Image& test, const Image& reference, int block) {
     checkSameSize(test, reference);
     double se = 0, refSum = 0;

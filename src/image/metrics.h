@@ -49,6 +49,21 @@ RelErrorSpread relativeErrorSpread(const Image& test, const Image& reference, fl
 // not positive. Throws InputError if the sizes differ.
 double lowFrequencyError(const Image& test, const Image& reference, int block = 8);
 
+// Whether two renders of one scene whose random numbers differ (two
+// unbiased estimators, or one drawn in another order) agree: the per-pixel
+// differences test - reference over the whole image (region 0) and each
+// quadrant (1-4, row by row), per channel (R, G, B, A), as z = their mean
+// over its standard error. Pixels non-finite in either image are left out;
+// a region whose differences are all zero has z = 0.
+struct PairedAgreement {
+    static constexpr int Regions = 5, Channels = 4;
+    double z[Regions][Channels] = {};
+    double maxAbsZ = 0;      // the largest |z|
+    int region = 0, channel = 0;  // where
+};
+// Throws InputError if the sizes differ.
+PairedAgreement pairedAgreement(const Image& test, const Image& reference);
+
 // PNG of the per-pixel error |a-b| averaged over RGB, divided by its 99th
 // percentile (so a few fireflies do not wash out the rest) and mapped through
 // the viridis ramp: dark purple = no error, yellow = at or above the 99th

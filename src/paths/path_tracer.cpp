@@ -32,9 +32,12 @@ void startVertex(PathState& st, const Vec3& x, const Vec3& wi, float pdf, bool c
     st.mirrorCounted = false;
 }
 
-// Russian roulette on the throughput after RouletteMinDepth events.
-bool roulette(Color& beta, const PathState& st, Rng& rng) {
-    return st.depth < RouletteMinDepth || russianRoulette(beta, rng, ScatterRouletteThreshold, st.rouletteScale);
+
+// sigma_s / sigma_t per channel (0 where sigma_t is).
+Color singleScatteringAlbedo(const MediumPoint& mp) {
+    Color a(0);
+    for (int c = 0; c < 3; ++c) a[c] = mp.sigma_t[c] > 0 ? mp.sigma_s[c] / mp.sigma_t[c] : 0.f;
+    return a;
 }
 
 // The state after a reflection or refraction at surface `surface`.
@@ -50,9 +53,10 @@ void followSurfaceEvent(const SurfaceEvent& e, int surface, PathState& st) {
 // events of PathTracer::trace.
 class PathWalk {
 public:
-    PathWalk(const PathTracer& t, ThreadContext& c, Ray r, int reg, int ch, Rng& g, PathState s)
+    PathWalk(const PathTracer& t, ThreadContext& c, Ray r, int reg, int ch, Rng& g, PathState s, const Color& b)
         : tracer(t), scene(t.mScene), strategies(*t.mStrategies), ctx(c), rng(g), ray(r), region(reg), channel(ch),
-          st(s), startDepth(s.depth), maxDepth(t.mScene.desc.render.maxDepth) {}
+          st(s), startDepth(s.depth),
+          maxDepth(t.mOptions.maxDepth >= 0 ? t.mOptions.maxDepth : t.mScene.desc.render.maxDepth), beta(b) {}
 
     // Adds c, after `events` scattering events, to L (and to the direct part).
     void add(const Color& c, int events) {
@@ -64,13 +68,37 @@ public:
         add(c, events);
         if (events == 0) emitted += c;
     }
-    PathRadiance result(float transmittance) const { return PathRadiance{L, transmittance, direct, emitted}; }
+    // transmittance: of the background the path ends on.
+    PathRadiance result(float transmittance) const {
+        return PathRadiance{L, transmittance + through, direct, emitted, first};
+    }
 
+    // The first event (FirstEvent): a point met, and where the first
+    // non-specular event gives albedo and normal.
+    void meet(const Vec3& p) {
+        if (!first.hasDepth) first.depthPoint = p;
+        first.hasDepth = true;
+    }
+    void firstEventAt(const Vec3& p, const Color& albedo, const Vec3& normal) {
+        meet(p);
+        if (first.done) return;
+        first.albedo = beta * albedo;
+        first.normal = normal;
+        first.done = true;
+    }
+
+    // How the path crossed a segment's media.
+    enum class Crossing { Reached, Scattered, Ended };
     float probeLength() const;
-    void sampleDistances(const PathSegment& seg);
-    bool scatterAt(Vec3 x, float t, const MediumPoint& mp, const PathSegment& seg);
+    Crossing cross(const RaySegment& seg);
     void hitLight(int light, float tEnd);
+    float hitBackground();
     bool surfaceEvent(const SurfaceHit& h);
+    // Russian roulette on the throughput after PathOptions::rouletteMinDepth events.
+    bool roulette() {
+        const PathOptions& o = tracer.mOptions;
+        return st.depth < o.rouletteMinDepth || russianRoulette(beta, rng, o.rouletteThreshold, st.rouletteScale);
+    }
 
     const PathTracer& tracer;
     const Scene& scene;
@@ -81,14 +109,24 @@ public:
     int region, channel;
     PathState st;
     const int startDepth, maxDepth;
-    Color L{0}, beta{1}, direct{0}, emitted{0};
+    Color beta;
+    Color L{0}, direct{0}, emitted{0};
+    // The background seen through glass reflections counted whole
+    // (PathSurfaceEvent::backgroundSeen) and through split glass events.
+    float through = 0;
+    FirstEvent first;
     unsigned prepared = 0;  // bit i: distance strategy i prepared the current segment
 
 private:
+    void sampleDistances(const PathSegment& seg);
+    Crossing track(const RaySegment& seg);
+    bool scatterAt(Vec3 x, float t, const MediumPoint& mp, const PathSegment& seg);
     bool nextEvent(const ScatterVertex& vertex, const CollisionWeights& w);
+    void split(const PathSurfaceEvent& pe, int surface);
 };
 
 float PathWalk::probeLength() const {
+    if (tracer.mOptions.march) return Infinity;  // a march reads the whole segment
     const Region& r = scene.regions[size_t(region)];
     if (!r.constant) return Infinity;
     const float sigmaT = trackedSigmaT(r.unboundedSigmaT, channel);
@@ -165,6 +203,7 @@ bool PathWalk::scatterAt(Vec3 x, float t, const MediumPoint& mp, const PathSegme
 // the next-event estimate at the last vertex (a sampled direction) or
 // against the connections through the specular chain since (power heuristic).
 void PathWalk::hitLight(int light, float tEnd) {
+    meet(ray.at(tEnd));
     const Light& l = scene.lights[size_t(light)];
     float w = 1;
     if (!st.specular) {
@@ -173,6 +212,21 @@ void PathWalk::hitLight(int light, float tEnd) {
         w = strategies.pathHitWeight(st.chain, light, st.lastPoint, st.lastDir, st.lastPdf, ray.at(tEnd));
     }
     if (!st.mirrorCounted) addEmitted(beta * l.emittedRadiance() * w, st.depth);
+}
+
+// Both outcomes of a split glass event, each followed by a path of its
+// own: the reflection, then the refraction.
+void PathWalk::split(const PathSurfaceEvent& pe, int surface) {
+    ++st.glassSplits;
+    PathState sr = st, sT = st;
+    followSurfaceEvent(pe.mirror, surface, sr);
+    followSurfaceEvent(pe.event, surface, sT);
+    const PathRadiance r = tracer.walk(ctx, pe.mirror.ray, pe.mirror.region, channel, rng, sr, beta * pe.mirrorWeight);
+    const PathRadiance t = tracer.walk(ctx, pe.event.ray, pe.event.region, channel, rng, sT, beta * pe.weight);
+    L = L + r.L + t.L;
+    direct = direct + r.direct + t.direct;
+    emitted = emitted + r.emitted + t.emitted;
+    through = through + r.transmittance + t.transmittance;
 }
 
 // The shared surface event at h; false when the path ends there.
@@ -185,25 +239,21 @@ bool PathWalk::surfaceEvent(const SurfaceHit& h) {
     const SurfaceRequest request{st.depth == 0 && st.glassSplits < SplitDielectricEvents, st.depth == 0};
     const PathSurfaceEvent pe = strategies.surfaceEvent(ctx, h, ray.d, region, u, request, rng);
     add(beta * pe.light, st.depth);
+    if (st.depth == startDepth) through += average(beta) * pe.backgroundSeen;
     st.mirrorCounted = pe.mirrorCounted;
     if (pe.split) {
-        ++st.glassSplits;
-        PathState sr = st;
-        followSurfaceEvent(pe.mirror, h.surface, sr);
-        const Color br = beta * pe.mirrorWeight;
-        sr.rouletteScale = std::min(sr.rouletteScale * average(br), 1e20f);
-        const PathRadiance pr = tracer.trace(ctx, pe.mirror.ray, pe.mirror.region, channel, rng, sr);
-        L += br * pr.L;
-        direct += br * pr.direct;
-        emitted += br * pr.emitted;
+        split(pe, h.surface);
+        return false;
     }
     const SurfaceEvent& e = pe.event;
     Color weight = pe.weight;
     Ray next = e.ray;
     const bool diffuse = e.kind == SurfaceEvent::Kind::Diffuse;
+    if (!e.straight) meet(h.p);  // interfaces and index-matched glass are invisible
     if (diffuse) {
-        if (++st.depth > maxDepth) return false;
         const Color& albedo = scene.surfaces[size_t(h.surface)].material.albedo;
+        firstEventAt(h.p, albedo, dot(h.ns, ray.d) > 0 ? -h.ns : h.ns);
+        if (++st.depth > maxDepth) return false;
         ScatterVertex vertex = ScatterVertex::onSurface(h.p, ray.d, h.n, albedo);
         const DirectionStrategy* directions = tracer.attachDirections(ctx, region, vertex);
         const bool connected = nextEvent(vertex, CollisionWeights{});
@@ -222,7 +272,55 @@ bool PathWalk::surfaceEvent(const SurfaceHit& h) {
     beta *= weight;
     ray = next;
     region = e.region;
-    return !diffuse || roulette(beta, st, rng);
+    return !diffuse || roulette();
+}
+
+// The path left the scene: the background, weighed against next-event
+// estimation's samples of an environment map at the last vertex (MIS).
+// Returns the transmittance to it (camera paths that never scattered).
+float PathWalk::hitBackground() {
+    const Environment& env = scene.environment;
+    const float mis = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(ray.d)) : 1.f;
+    // A camera path that never scattered sees the map as a backdrop.
+    if (!st.mirrorCounted) add(beta * (st.depth == 0 ? env.radianceSeen(ray.d) : env.radiance(ray.d)) * mis, st.depth);
+    return st.depth == startDepth ? average(beta) : 0.f;
+}
+
+// Delta tracking to the next real collision, or to the segment's end.
+PathWalk::Crossing PathWalk::track(const RaySegment& seg) {
+    const PathSegment path{ray, region, channel, seg.tEnd, tracer.mOptions.pointLightsByPhotons};
+    sampleDistances(path);
+    // The collision callback returns false once the path scattered or was
+    // absorbed.
+    bool scattered = false;
+    MediumPoint mp;
+    deltaTrack(ctx, region, ray, seg.tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+        evalMedia(ctx, region, x, mp);
+        ++ctx.counters.marchSamples;
+        // Emission: sigma_a L_e / sigma_maj at every tentative collision.
+        if (!isBlack(mp.emission)) addEmitted(beta * mp.sigma_a * mp.emission / sigmaMaj, st.depth);
+        const float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
+        const float u = rng.uniform() * sigmaMaj;
+        if (u < sa + ss && !first.done) firstEventAt(x, singleScatteringAlbedo(mp), -ray.d);  // a real collision
+        if (u < sa) {
+            beta = Color(0);  // absorbed
+            return false;
+        }
+        if (u >= sa + ss) return true;  // null collision
+        // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
+        beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+        scattered = scatterAt(x, dot(x - ray.o, ray.d), mp, path);
+        return false;
+    });
+    if (isBlack(beta)) return Crossing::Ended;
+    if (scattered) return roulette() ? Crossing::Scattered : Crossing::Ended;
+    return Crossing::Reached;
+}
+
+PathWalk::Crossing PathWalk::cross(const RaySegment& seg) {
+    if (const SegmentMarch* m = tracer.mOptions.march)
+        return m->march(ctx, region, ray, seg.tEnd, st.depth, rng, L, beta) ? Crossing::Reached : Crossing::Ended;
+    return track(seg);
 }
 
 PathTracer::PathTracer(const Scene& scene, std::shared_ptr<const StrategySet> strategies, PathOptions options)
@@ -240,38 +338,17 @@ void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float 
 }
 
 PathRadiance PathTracer::trace(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state) const {
-    PathWalk w(*this, ctx, ray, region, channel, rng, state);
-    MediumPoint mp;
+    return walk(ctx, ray, region, channel, rng, state, Color(1));
+}
+
+PathRadiance PathTracer::walk(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state,
+                              const Color& beta) const {
+    PathWalk w(*this, ctx, ray, region, channel, rng, state, beta);
     while (true) {
         const RaySegment seg = nextRaySegment(mScene, w.ray, w.probeLength());
-        const PathSegment path{w.ray, w.region, channel, seg.tEnd, mOptions.pointLightsByPhotons};
-        w.sampleDistances(path);
-        // Delta tracking to the next real collision, or to tEnd; the
-        // collision callback returns false once the path scattered or was
-        // absorbed.
-        bool scattered = false;
-        deltaTrack(ctx, w.region, w.ray, seg.tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
-            evalMedia(ctx, w.region, x, mp);
-            ++ctx.counters.marchSamples;
-            // Emission: sigma_a L_e / sigma_maj at every tentative collision.
-            if (!isBlack(mp.emission)) w.addEmitted(w.beta * mp.sigma_a * mp.emission / sigmaMaj, w.st.depth);
-            const float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
-            const float u = rng.uniform() * sigmaMaj;
-            if (u < sa) {
-                w.beta = Color(0);  // absorbed
-                return false;
-            }
-            if (u >= sa + ss) return true;  // null collision
-            // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
-            w.beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
-            scattered = w.scatterAt(x, dot(x - w.ray.o, w.ray.d), mp, path);
-            return false;
-        });
-        if (isBlack(w.beta)) return w.result(0.f);
-        if (scattered) {
-            if (!roulette(w.beta, w.st, rng)) return w.result(0.f);
-            continue;
-        }
+        const PathWalk::Crossing c = w.cross(seg);
+        if (c == PathWalk::Crossing::Ended) return w.result(0.f);
+        if (c == PathWalk::Crossing::Scattered) continue;
         // Reached tEnd without a real collision.
         if (seg.cut) {  // the end of the probed length: the same free flight goes on
             w.ray.o = w.ray.at(seg.tEnd);
@@ -281,17 +358,7 @@ PathRadiance PathTracer::trace(ThreadContext& ctx, Ray ray, int region, int chan
             w.hitLight(seg.light, seg.tEnd);
             return w.result(0.f);
         }
-        if (!seg.hitSurface) {
-            // An environment map was also sampled by next-event estimation
-            // at the last vertex (direct_light.cpp): weigh the two by MIS.
-            const Environment& env = mScene.environment;
-            const PathState& st = w.st;
-            const float mis = !st.specular && env.hasMap() ? powerHeuristic(st.lastPdf, env.pdf(w.ray.d)) : 1.f;
-            // A camera path that never scattered sees the map as a backdrop.
-            if (!st.mirrorCounted)
-                w.add(w.beta * (st.depth == 0 ? env.radianceSeen(w.ray.d) : env.radiance(w.ray.d)) * mis, st.depth);
-            return w.result(st.depth == w.startDepth && st.surfaceBounces == 0 ? average(w.beta) : 0.f);
-        }
+        if (!seg.hitSurface) return w.result(w.hitBackground());
         if (!w.surfaceEvent(seg.surface)) return w.result(0.f);
     }
 }

@@ -1,10 +1,13 @@
-// The volumetric path tracer's loop, written once for the reference method
-// (camera paths) and for the marchers' continuation estimate of L_i (paths
-// that start at a march sample):
-//  - free flights by delta tracking against local majorants (homogeneous
-//    media: exact exponential sampling), emission of eq. 1 collected at every
-//    tentative collision (sigma_a L_e / sigma_maj), absorption / scattering /
-//    null chosen by their ratios;
+// The one radiance-path loop: the reference method's camera paths, the
+// marchers' continuation estimate of L_i (paths that start at a march
+// sample) and the marchers' camera paths:
+//  - media crossed by free flights of delta tracking against local majorants
+//    (homogeneous media: exact exponential sampling), emission of eq. 1
+//    collected at every tentative collision (sigma_a L_e / sigma_maj),
+//    absorption / scattering / null chosen by their ratios; or, for the
+//    marchers' camera paths, marched segment by segment (SegmentMarch: eq. 3
+//    by quadrature, L_i at march samples), the path going on at the
+//    segment's end;
 //  - the render's sampling strategies (strategies/strategy.h), iterated in
 //    the set's order: distance samples along each segment, directions at
 //    each vertex, connections through specular surfaces;
@@ -23,6 +26,7 @@
 #include "core/rng.h"
 #include "strategies/strategy_set.h"
 #include "transport/direct_light.h"
+#include "transport/roulette.h"
 #include "transport/thread_context.h"
 
 namespace vdbmarch {
@@ -36,6 +40,19 @@ class InScatteredLight {
 public:
     virtual ~InScatteredLight() = default;
     virtual Color at(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const = 0;
+};
+
+// How a path crosses the media of a segment when it does not track them:
+// a ray marcher integrates emission and in-scattered light along [0, tEnd)
+// and attenuates the throughput, and the path goes on from tEnd
+// (estimators/segment_marcher.h). March samples are scattering events
+// number depth + 1: past max_depth a march adds emission only.
+class SegmentMarch {
+public:
+    virtual ~SegmentMarch() = default;
+    // Adds to L, attenuates beta; false when roulette ended the path.
+    virtual bool march(ThreadContext& ctx, int region, const Ray& ray, float tEnd, int depth, Rng& rng, Color& L,
+                       Color& beta) const = 0;
 };
 
 // Where a path stands when the loop takes it over.
@@ -61,11 +78,30 @@ struct PathState {
     bool firstVertexPending = true;
 };
 
+// The path's first event, for the feature AOVs (render.aovs depth, albedo,
+// normal; docs/aovs.md): its first real collision in a medium or its first
+// visible surface, glass followed to the first non-specular event for
+// albedo and normal, as OpenImageDenoise recommends.
+struct FirstEvent {
+    bool hasDepth = false;  // the path met a medium, a surface or a light
+    Vec3 depthPoint{0, 0, 0};  // where (before any bend)
+    // Throughput to the first non-specular event times its albedo (sigma_s /
+    // sigma_t in a medium, the diffuse albedo on a surface); zero when the
+    // path leaves the scene or ends on a light first.
+    Color albedo{0};
+    // Unit direction back along the path at a medium event, the shading
+    // normal facing the arriving ray on a diffuse surface, zero otherwise.
+    Vec3 normal{0, 0, 0};
+    bool done = false;  // the first non-specular event was met
+};
+
 // What a path brings back: a camera path's result (Estimator::radiance) and a
 // continuation's alike.
 struct PathRadiance {
     Color L;                  // radiance arriving at ray.o along -ray.d
-    float transmittance = 0;  // fraction of the background seen straight (camera paths; alpha = 1 - this)
+    // The fraction of the background seen with no scattering event, straight
+    // or through glass (camera paths; alpha = 1 - this).
+    float transmittance = 0;
     // The part of L after at most one scattering event in all (counting the
     // state's depth; emission and unscattered light included): the "direct"
     // AOV (docs/aovs.md). Zero for paths that start at depth >= 2; marchers
@@ -76,6 +112,7 @@ struct PathRadiance {
     // the estimator integrates emission smoothly, so the denoiser takes it
     // apart from the scattered light (docs/denoise.md, "Emission apart").
     Color emitted;
+    FirstEvent first;  // of a tracked path (marched paths: at surfaces only)
 };
 
 // What the estimator above sets once for all its paths.
@@ -86,6 +123,14 @@ struct PathOptions {
     bool pointLightsByPhotons = false;
     // Added at a path's first medium vertex (null: nothing).
     const InScatteredLight* firstVertexLight = nullptr;
+    // Media crossed by this march (null: delta tracking).
+    const SegmentMarch* march = nullptr;
+    // Russian roulette after scattering events from this depth on, by this
+    // threshold (transport/roulette.h).
+    int rouletteMinDepth = RouletteMinDepth;
+    float rouletteThreshold = ScatterRouletteThreshold;
+    // Scattering events allowed (-1: render.max_depth).
+    int maxDepth = -1;
 };
 
 class PathTracer {
@@ -103,6 +148,9 @@ public:
 
 private:
     friend class PathWalk;
+    // trace(), from throughput beta.
+    PathRadiance walk(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state,
+                      const Color& beta) const;
     const Scene& mScene;
     std::shared_ptr<const StrategySet> mStrategies;
     PathOptions mOptions;

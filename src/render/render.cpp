@@ -16,7 +16,6 @@
 #include "core/sobol.h"
 #include "core/threads.h"
 #include "render/render_state.h"
-#include "transport/first_event.h"
 
 namespace vdbmarch {
 
@@ -73,8 +72,9 @@ std::pair<int, int> samplesOfPasses(const Scene& scene, const PhotonPasses& phot
 // in the window's buffers): its radiance into the open pass's sums and its
 // odd half, and with AOVs the direct part and the first event's features. A
 // non-finite sample is dropped and counted, never written.
-void addCameraSample(const Scene& scene, const Estimator& marcher, ThreadContext& ctx, int x, int y, uint64_t pixel,
-                     int s, size_t local, PhotonPassSums& open, AovSums& aovSums) {
+void addCameraSample(const Scene& scene, const Estimator& marcher, const FirstEventTracer* firstEvents,
+                     ThreadContext& ctx, int x, int y, uint64_t pixel, int s, size_t local, PhotonPassSums& open,
+                     AovSums& aovSums) {
     const RenderSettings& rs = scene.desc.render;
     const AovSet& aovs = rs.aovs;
     Rng rng(hashValues(rs.seed, pixel), uint64_t(s));
@@ -101,9 +101,9 @@ void addCameraSample(const Scene& scene, const Estimator& marcher, ThreadContext
     }
     if (!aovs.any()) return;
     if (aovs.splitDirect()) aovSums.direct[local] += pr.direct;
-    if (aovs.firstEvent()) {
+    if (firstEvents) {
         Rng aovRng(hashValues(rs.seed, pixel, AovStream), uint64_t(s));
-        const FirstEvent fe = traceFirstEvent(ctx, ray, aovRng);
+        const FirstEvent fe = firstEvents->trace(ctx, ray, aovRng);
         if (aovs.depth && fe.hasDepth) {
             aovSums.depth[local] += double(scene.camera->viewDepth(fe.depthPoint));
             ++aovSums.depthSamples[local];
@@ -167,6 +167,7 @@ RenderState::RenderState(const Scene& scene, const RenderOptions& options)
 
 void RenderState::buildMarcher() {
     strategies = options.strategies ? options.strategies : StrategySet::build(scene);
+    if (aovs.firstEvent()) firstEvents = std::make_unique<FirstEventTracer>(scene);
     arena.execute([&] {
         illumination = std::make_shared<Illumination>(buildIllumination(scene, request));
         marcher = makeEstimator(rs.method, scene, illumination, strategies);
@@ -210,7 +211,8 @@ void RenderState::renderSweep(int s0, int s1) {
                         const auto t0 = timedAdaptive ? std::chrono::steady_clock::now()
                                                       : std::chrono::steady_clock::time_point();
                         for (int s = s0; s < s1; ++s)
-                            addCameraSample(scene, *marcher, ctx, x, y, pixel, s, local, film.open, film.aovs);
+                            addCameraSample(scene, *marcher, firstEvents.get(), ctx, x, y, pixel, s, local, film.open,
+                                            film.aovs);
                         if (timedAdaptive) {
                             times.seconds[local] +=
                                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include "estimators/estimator.h"
+#include "paths/first_event.h"
 #include "render/adaptive_sampling.h"
 #include "render/progress_bar.h"
 #include "render/render.h"
@@ -96,6 +97,7 @@ struct RenderState : RenderPlan {
     std::shared_ptr<const StrategySet> strategies;
     std::shared_ptr<Illumination> illumination;
     std::unique_ptr<Estimator> marcher;
+    std::unique_ptr<FirstEventTracer> firstEvents;  // the feature AOVs' paths (null: none asked)
     double firstIlluminationSeconds = 0;  // what the first photons and cache took
     // A resumed render's sample, counters and time before this run.
     int resumeSample = 0;

@@ -1,9 +1,11 @@
-// The low-frequency error of image/metrics.h: bias shows, pixel noise does not.
+// The low-frequency error of image/metrics.h: bias shows, pixel noise does
+// not; the paired agreement of two noisy renders: z by construction.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "image/metrics.h"
 
 namespace vdbmarch {
@@ -40,6 +42,39 @@ TEST(LowFrequencyError, ABlotchShowsAtItsBlockShare) {
 
 TEST(LowFrequencyError, SizesMustMatch) {
     EXPECT_THROW(lowFrequencyError(constantImage(8, 8, 1.f), constantImage(8, 9, 1.f)), InputError);
+}
+
+// Two images of unit-variance noise about the same value: |z| <= 4 in every
+// region and channel; a bias of b in one quadrant's red, n pixels there,
+// shows as z = b sqrt(n) / sqrt(2) (the differences' variance is 2).
+TEST(PairedAgreement, NoiseAgreesAndAQuadrantBiasShowsAtItsZ) {
+    const int W = 64, H = 48;
+    Image a(W, H), b(W, H);
+    Rng rng(11, 0);
+    auto gauss = [&] {
+        const double u1 = 1 - double(rng.uniform()), u2 = double(rng.uniform());
+        return float(std::sqrt(-2 * std::log(u1)) * std::cos(6.283185307179586 * u2));
+    };
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            a.set(x, y, Color(5 + gauss(), 5 + gauss(), 5 + gauss()), 1.f);
+            b.set(x, y, Color(5 + gauss(), 5 + gauss(), 5 + gauss()), 1.f);
+        }
+    const PairedAgreement same = pairedAgreement(a, b);
+    EXPECT_LE(same.maxAbsZ, 4.0);
+    EXPECT_EQ(same.z[0][3], 0.0);  // alpha identical
+    const double bias = 0.5, n = double(W / 2 * H / 2);
+    Image c = b;
+    for (int y = H / 2; y < H; ++y)
+        for (int x = W / 2; x < W; ++x) c.rgba[4 * (size_t(y) * W + size_t(x))] += float(bias);
+    const PairedAgreement biased = pairedAgreement(c, a);
+    const double expected = bias * std::sqrt(n) / std::sqrt(2.0);  // 12.2
+    EXPECT_EQ(biased.region, 4);
+    EXPECT_EQ(biased.channel, 0);
+    // Less the noise's own z, the bias over the sample standard error, whose
+    // relative error is 1 / sqrt(2 n) (4 sigma: 10 %).
+    EXPECT_NEAR(biased.z[4][0] + same.z[4][0], expected, 0.1 * expected) << biased.z[4][0];
+    EXPECT_THROW(pairedAgreement(a, Image(W, H + 1)), InputError);
 }
 
 }  // namespace

@@ -422,6 +422,31 @@ TEST(Reference, VdbBoxAlphaIsBeerLambertInExpectation) {
     EXPECT_NEAR(a.mean, 1 - std::exp(-1.0), 4 * a.stdError);
 }
 
+// Alpha is the background seen with no scattering event, through glass
+// too, for every method: a glass ball in vacuum (fog only out of view)
+// covering about a quarter of the frame hides almost none of the background
+// (paths end inside it only at the surface-bounce limit), where counting
+// glass as opaque would give a mean alpha near 0.25.
+TEST(Alpha, GlassHidesNoBackgroundForAnyMethod) {
+    auto render = [](Method m) {
+        auto scene = sceneFromJson(std::string(R"({"camera": {"type": "perspective", "position": [0, 0, 4], "look_at": [0, 0, 0],
+            "fov_deg": 30, "resolution": [24, 24]},
+            "lights": [{"type": "directional", "direction": [0, -1, 0], "irradiance": 1}],
+            "media": [{"type": "homogeneous", "sigma_a": 0.1, "sigma_s": 0.5,
+                       "bounds": {"min": [5, 5, 5], "max": [6, 6, 6]}}],
+            "surfaces": [{"shape": "sphere", "transform": {"scale": 0.55},
+                          "material": {"type": "dielectric", "ior": 1.5}}],
+            "render": {"spp": 8, "seed": 3, "max_depth": 2, "method": ")") +
+                                   methodName(m) + R"("}})");
+        return renderImage(*scene).image;
+    };
+    for (Method m : estimatorMethods()) {
+        const Image img = render(m);
+        const ChannelStats a = pixelStats(img, 3);
+        EXPECT_LT(a.mean, 0.02) << methodName(m);
+    }
+}
+
 // Agreement: with max_depth 1 the reference and the uniform marcher estimate
 // the same single-scattering image of a heterogeneous VDB cloud behind a
 // glass sphere (directional light and sky; straight shadow rays for both).
