@@ -1,6 +1,7 @@
 // The one radiance-path loop: the reference method's camera paths, the
 // marchers' continuation estimate of L_i (paths that start at a march
-// sample) and the marchers' camera paths:
+// sample), the marchers' camera paths and the feature AOVs' first-event
+// paths (paths/first_event.h):
 //  - media crossed by free flights of delta tracking against local majorants
 //    (homogeneous media: exact exponential sampling), emission of eq. 1
 //    collected at every tentative collision (sigma_a L_e / sigma_maj),
@@ -14,8 +15,8 @@
 //  - next-event estimation to every light at every scattering vertex with
 //    unbiased ray-marching transmittance; sphere lights are also hit by the
 //    path and the strategies meet by the power heuristic;
-//  - the shared surface event, Russian roulette after RouletteMinDepth
-//    events; max_depth counts scattering events (media and diffuse surfaces).
+//  - the shared surface event, Russian roulette (PathOptions); max_depth
+//    counts scattering events (media and diffuse surfaces).
 // Media whose extinction differs between RGB channels are tracked one
 // channel per path (`channel` >= 0), which keeps every estimator unbiased;
 // grey-extinction media share one path with RGB weights (channel < 0).
