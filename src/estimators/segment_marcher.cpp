@@ -27,11 +27,6 @@ SegmentMarcher::SegmentMarcher(const EstimatorInputs& in)
     mLastEventByNextEvent = !hasBendingGlass(scene);
     for (const auto& m : scene.media) mLastEventByNextEvent = mLastEventByNextEvent && !m->hasEmission;
     if (!mIllumination) throw std::logic_error("SegmentMarcher needs an Illumination");
-    for (const Region& r : scene.regions) {
-        bool emits = false;
-        for (int m : r.media) emits = emits || scene.media[size_t(m)]->hasEmission;
-        mRegionEmits.push_back(emits);
-    }
 }
 
 // The marchers' tallies of the direct and emitted parts (tallyEmission,
@@ -52,7 +47,7 @@ bool SegmentMarcher::march(ThreadContext& ctx, int region, const Ray& ray, float
     scratch(ctx).pathDepth = depth;
     // Past max_depth a march adds emission only: where the region emits
     // none, the path needs just the segment's transmittance.
-    if (!scatters(ctx) && !mRegionEmits[size_t(region)]) {
+    if (!scatters(ctx) && !mScene.regions[size_t(region)].emits) {
         beta *= regionTransmittance(ctx, region, ray, tEnd, rng);
         return true;
     }

@@ -106,7 +106,6 @@ protected:
     const bool mChromatic;  // continuation paths track one channel
     const bool mTallyDirect;  // render.aovs asks for direct or indirect
     bool mLastEventByNextEvent = true;  // see the constructor
-    std::vector<char> mRegionEmits;  // per region: some medium in it emits
     PathTracer mPaths;  // continuation paths, with the render's strategies
     PathTracer mCameraPaths;  // camera paths, marched by this
 };

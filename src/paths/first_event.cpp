@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "transport/surface_event.h"
 #include "transport/tracking.h"
 
 namespace vdbmarch {

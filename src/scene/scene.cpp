@@ -231,6 +231,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
         region.constant = !region.media.empty();
         for (int mi : region.media) {
             const MediumDesc& md = desc.media[size_t(mi)];
+            region.emits = region.emits || scene->media[size_t(mi)]->hasEmission;
             region.constant = region.constant && md.type == MediumDesc::Type::Homogeneous && !md.hasBounds &&
                               !scene->media[size_t(mi)]->hasEmission;
         }

@@ -23,6 +23,7 @@ struct Region {
     // Every medium in it is homogeneous, unbounded and not emissive: the
     // extinction is unboundedSigmaT everywhere in the region.
     bool constant = false;
+    bool emits = false;  // some medium in it emits
 };
 
 struct SurfaceInfo {
