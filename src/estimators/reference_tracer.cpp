@@ -2,8 +2,8 @@
 // paths/path_tracer.h from the camera (delta tracking against local
 // majorants, emission at tentative collisions, next-event estimation with
 // MIS for sphere lights, the shared surface event). Media whose extinction
-// differs between RGB channels are tracked one channel per path (three
-// paths per sample).
+// differs between RGB channels are tracked with spectral MIS from a hero
+// channel (HeroChannel): one path per sample carries all three.
 //
 // A path cannot find a delta light through refracting glass (shadow rays
 // cannot bend): where a scene has such caustics, the photons flagged
@@ -43,17 +43,9 @@ public:
     PathRadiance radiance(const Ray& cameraRay, Rng& rng, ThreadContext& ctx) const override {
         ++ctx.counters.cameraRays;
         const int region = regionAtRayStart(mScene, cameraRay);
-        const PathState start;
-        if (!mChromatic) return mPaths.trace(ctx, cameraRay, region, -1, rng, start);
-        PathRadiance out{Color(0), 0.f, Color(0), Color(0), FirstEvent{}};
-        for (int c = 0; c < 3; ++c) {
-            PathRadiance p = mPaths.trace(ctx, cameraRay, region, c, rng, start);
-            out.L[c] = p.L[c];
-            out.direct[c] = p.direct[c];
-            out.emitted[c] = p.emitted[c];
-            out.transmittance += p.transmittance / 3;
-        }
-        return out;
+        PathState start;
+        start.spectral = startingHero(mChromatic, rng);
+        return mPaths.trace(ctx, cameraRay, region, rng, start);
     }
 
 private:

@@ -210,7 +210,7 @@ private:
                 lights.clear();
                 const StrategySet& strategies = mPaths.strategies();
                 if (mLightShare > 0 &&
-                    strategies.lightDistances().prepare(ctx, PathSegment{ray, region, -1, tEnd, false}))
+                    strategies.lightDistances().prepare(ctx, PathSegment{ray, region, HeroChannel{}, tEnd, false}))
                     lights = strategies.lightDistances().prepared(ctx);
                 const double a = lights.empty() ? 0.0 : mLightShare;
                 FoldSampler& folds = m.foldDistances;

@@ -36,7 +36,7 @@ PathRadiance SegmentMarcher::radiance(const Ray& cameraRay, Rng& rng, ThreadCont
     MarcherScratch& m = scratch(ctx);
     m.direct = Color(0);
     m.emitted = Color(0);
-    PathRadiance r = mCameraPaths.trace(ctx, cameraRay, regionAtRayStart(mScene, cameraRay), -1, rng, PathState{});
+    PathRadiance r = mCameraPaths.trace(ctx, cameraRay, regionAtRayStart(mScene, cameraRay), rng, PathState{});
     r.direct = mTallyDirect ? r.direct + m.direct : Color(0);
     r.emitted += m.emitted;
     return r;
@@ -133,15 +133,11 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         state.lastPoint = x;
         state.connectedAtLast = connected;
         state.lastDir = wi;
-        if (pdf > 0 && !mChromatic) {
-            const PathRadiance p = mPaths.trace(ctx, Ray{x, wi}, region, -1, rng, state);
+        if (pdf > 0) {
+            state.spectral = startingHero(mChromatic, rng);
+            const PathRadiance p = mPaths.trace(ctx, Ray{x, wi}, region, rng, state);
             Li += weight * p.L;
             if (tallyHere) m.liDirect += weight * p.direct;
-        } else if (pdf > 0) {  // one channel, picked uniformly: 3 times its radiance
-            const int c = std::min(2, int(rng.uniform() * 3));
-            const PathRadiance p = mPaths.trace(ctx, Ray{x, wi}, region, c, rng, state);
-            Li[c] += 3 * weight[c] * p.L[c];
-            if (tallyHere) m.liDirect[c] += 3 * weight[c] * p.direct[c];
         }
     }
     return Li + photons();

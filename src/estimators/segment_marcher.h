@@ -103,7 +103,7 @@ protected:
 
     const Scene& mScene;
     std::shared_ptr<const Illumination> mIllumination;
-    const bool mChromatic;  // continuation paths track one channel
+    const bool mChromatic;  // continuation paths track with spectral MIS (HeroChannel)
     const bool mTallyDirect;  // render.aovs asks for direct or indirect
     bool mLastEventByNextEvent = true;  // see the constructor
     PathTracer mPaths;  // continuation paths, with the render's strategies

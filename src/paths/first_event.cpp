@@ -14,9 +14,10 @@ FirstEventTracer::FirstEventTracer(const Scene& scene)
       }()) {}
 
 FirstEvent FirstEventTracer::trace(ThreadContext& ctx, const Ray& cameraRay, Rng& rng) const {
-    const int channel = mChromatic ? std::min(2, int(rng.uniform() * 3)) : -1;
+    PathState start;
+    start.spectral = startingHero(mChromatic, rng);
     const RenderCounters counters = ctx.counters;
-    const FirstEvent e = mPaths.trace(ctx, cameraRay, regionAtRayStart(mScene, cameraRay), channel, rng, PathState{}).first;
+    const FirstEvent e = mPaths.trace(ctx, cameraRay, regionAtRayStart(mScene, cameraRay), rng, start).first;
     ctx.counters = counters;
     return e;
 }

@@ -12,9 +12,9 @@ namespace vdbmarch {
 class FirstEventTracer {
 public:
     explicit FirstEventTracer(const Scene& scene);
-    // Chromatic extinction: the free flight of one channel picked
-    // uniformly, so the event density is the channels' average (as the
-    // reference's). Not counted in the render's statistics.
+    // Chromatic extinction: spectral MIS from a hero channel picked
+    // uniformly, as the reference's paths. Not counted in the render's
+    // statistics.
     FirstEvent trace(ThreadContext& ctx, const Ray& cameraRay, Rng& rng) const;
 
 private:

@@ -53,9 +53,8 @@ void followSurfaceEvent(const SurfaceEvent& e, int surface, PathState& st) {
 // events of PathTracer::trace.
 class PathWalk {
 public:
-    PathWalk(const PathTracer& t, ThreadContext& c, Ray r, int reg, int ch, Rng& g, PathState s, const Color& b)
-        : tracer(t), scene(t.mScene), strategies(*t.mStrategies), ctx(c), rng(g), ray(r), region(reg), channel(ch),
-          st(s), startDepth(s.depth),
+    PathWalk(const PathTracer& t, ThreadContext& c, Ray r, int reg, Rng& g, PathState s, const Color& b)
+        : tracer(t), scene(t.mScene), strategies(*t.mStrategies), ctx(c), rng(g), ray(r), region(reg), st(s), startDepth(s.depth),
           maxDepth(t.mOptions.maxDepth >= 0 ? t.mOptions.maxDepth : t.mScene.desc.render.maxDepth), beta(b) {}
 
     // Adds c, after `events` scattering events, to L (and to the direct part).
@@ -106,7 +105,7 @@ public:
     ThreadContext& ctx;
     Rng& rng;
     Ray ray;
-    int region, channel;
+    int region;
     PathState st;
     const int startDepth, maxDepth;
     Color beta;
@@ -129,7 +128,7 @@ float PathWalk::probeLength() const {
     if (tracer.mOptions.march) return Infinity;  // a march reads the whole segment
     const Region& r = scene.regions[size_t(region)];
     if (!r.constant) return Infinity;
-    const float sigmaT = trackedSigmaT(r.unboundedSigmaT, channel);
+    const float sigmaT = majorantSigmaT(r.unboundedSigmaT);
     if (!(sigmaT > 0) || strategies.needsSegmentEnd(region, tracer.mOptions.pointLightsByPhotons)) return Infinity;
     return ProbeFreePaths / sigmaT;
 }
@@ -221,8 +220,8 @@ void PathWalk::split(const PathSurfaceEvent& pe, int surface) {
     PathState sr = st, sT = st;
     followSurfaceEvent(pe.mirror, surface, sr);
     followSurfaceEvent(pe.event, surface, sT);
-    const PathRadiance r = tracer.walk(ctx, pe.mirror.ray, pe.mirror.region, channel, rng, sr, beta * pe.mirrorWeight);
-    const PathRadiance t = tracer.walk(ctx, pe.event.ray, pe.event.region, channel, rng, sT, beta * pe.weight);
+    const PathRadiance r = tracer.walk(ctx, pe.mirror.ray, pe.mirror.region, rng, sr, beta * pe.mirrorWeight);
+    const PathRadiance t = tracer.walk(ctx, pe.event.ray, pe.event.region, rng, sT, beta * pe.weight);
     L = L + r.L + t.L;
     direct = direct + r.direct + t.direct;
     emitted = emitted + r.emitted + t.emitted;
@@ -288,27 +287,35 @@ float PathWalk::hitBackground() {
 
 // Delta tracking to the next real collision, or to the segment's end.
 PathWalk::Crossing PathWalk::track(const RaySegment& seg) {
-    const PathSegment path{ray, region, channel, seg.tEnd, tracer.mOptions.pointLightsByPhotons};
+    const PathSegment path{ray, region, st.spectral, seg.tEnd, tracer.mOptions.pointLightsByPhotons};
     sampleDistances(path);
     // The collision callback returns false once the path scattered or was
     // absorbed.
     bool scattered = false;
     MediumPoint mp;
-    deltaTrack(ctx, region, ray, seg.tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+    HeroChannel& spectral = st.spectral;
+    deltaTrack(ctx, region, ray, seg.tEnd, rng, [&](const Vec3& x, float sigmaMaj) {
         evalMedia(ctx, region, x, mp);
         ++ctx.counters.marchSamples;
         // Emission: sigma_a L_e / sigma_maj at every tentative collision.
         if (!isBlack(mp.emission)) addEmitted(beta * mp.sigma_a * mp.emission / sigmaMaj, st.depth);
-        const float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
+        const float sa = spectral.of(mp.sigma_a), ss = spectral.of(mp.sigma_s);
         const float u = rng.uniform() * sigmaMaj;
         if (u < sa + ss && !first.done) firstEventAt(x, singleScatteringAlbedo(mp), -ray.d);  // a real collision
         if (u < sa) {
             beta = Color(0);  // absorbed
             return false;
         }
-        if (u >= sa + ss) return true;  // null collision
+        if (u >= sa + ss) {  // null collision
+            if (spectral.channel < 0) return true;
+            spectral.weigh(max(Color(sigmaMaj) - mp.sigma_t, Color(0)), beta);
+            return !spectral.clearIn(scene.regions[size_t(region)].coefficients);
+        }
         // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
-        beta *= (channel < 0 ? mp.sigma_s / ss : Color(1));
+        if (spectral.channel < 0)
+            beta *= mp.sigma_s / ss;
+        else
+            spectral.weigh(mp.sigma_s, beta);
         scattered = scatterAt(x, dot(x - ray.o, ray.d), mp, path);
         return false;
     });
@@ -337,13 +344,13 @@ void scaleRoulette(PathState& st, const ScatterVertex& v, const Vec3& wi, float 
     if (pf > 0 && pdf > 0) st.rouletteScale = std::min(st.rouletteScale * (pdf / pf), 1e20f);
 }
 
-PathRadiance PathTracer::trace(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state) const {
-    return walk(ctx, ray, region, channel, rng, state, Color(1));
+PathRadiance PathTracer::trace(ThreadContext& ctx, Ray ray, int region, Rng& rng, PathState state) const {
+    return walk(ctx, ray, region, rng, state, Color(1));
 }
 
-PathRadiance PathTracer::walk(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state,
+PathRadiance PathTracer::walk(ThreadContext& ctx, Ray ray, int region, Rng& rng, PathState state,
                               const Color& beta) const {
-    PathWalk w(*this, ctx, ray, region, channel, rng, state, beta);
+    PathWalk w(*this, ctx, ray, region, rng, state, beta);
     while (true) {
         const RaySegment seg = nextRaySegment(mScene, w.ray, w.probeLength());
         const PathWalk::Crossing c = w.cross(seg);

@@ -17,11 +17,13 @@
 //    path and the strategies meet by the power heuristic;
 //  - the shared surface event, Russian roulette (PathOptions); max_depth
 //    counts scattering events (media and diffuse surfaces).
-// Media whose extinction differs between RGB channels are tracked one
-// channel per path (`channel` >= 0), which keeps every estimator unbiased;
-// grey-extinction media share one path with RGB weights (channel < 0).
+// Media whose extinction differs between RGB channels are tracked with
+// spectral MIS from a hero channel (PathState::spectral, HeroChannel in
+// transport/tracking.h): one path carries all three channels, each weighed
+// by the balance heuristic over the channels' densities.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 
 #include "core/rng.h"
@@ -77,7 +79,18 @@ struct PathState {
     bool mirrorCounted = false;
     // PathOptions::firstVertexLight is still to be added.
     bool firstVertexPending = true;
+    // Spectral MIS in chromatic media: the hero channel (< 0 for grey
+    // extinction) and the channels' path densities (startingHero).
+    HeroChannel spectral;
 };
+
+// A path's starting spectral state: a hero channel drawn uniformly where
+// some medium's extinction differs between channels, else grey.
+inline HeroChannel startingHero(bool chromatic, Rng& rng) {
+    HeroChannel h;
+    if (chromatic) h.channel = std::min(2, int(rng.uniform() * 3));
+    return h;
+}
 
 // The path's first event, for the feature AOVs (render.aovs depth, albedo,
 // normal; docs/aovs.md): its first real collision in a medium or its first
@@ -139,7 +152,7 @@ public:
     PathTracer(const Scene& scene, std::shared_ptr<const StrategySet> strategies, PathOptions options = {});
 
     // The radiance the path ray (in `region`) brings back, from `state`.
-    PathRadiance trace(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state) const;
+    PathRadiance trace(ThreadContext& ctx, Ray ray, int region, Rng& rng, PathState state) const;
 
     const Scene& scene() const { return mScene; }
     const StrategySet& strategies() const { return *mStrategies; }
@@ -150,7 +163,7 @@ public:
 private:
     friend class PathWalk;
     // trace(), from throughput beta.
-    PathRadiance walk(ThreadContext& ctx, Ray ray, int region, int channel, Rng& rng, PathState state,
+    PathRadiance walk(ThreadContext& ctx, Ray ray, int region, Rng& rng, PathState state,
                       const Color& beta) const;
     const Scene& mScene;
     std::shared_ptr<const StrategySet> mStrategies;

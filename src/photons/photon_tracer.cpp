@@ -67,23 +67,18 @@ public:
         }
         power = ep.power / float(src.count);
         if (!(maxComponent(power) > 0) || !std::isfinite(maxComponent(power))) return;
-        int channel = -1;
-        if (mChromatic) {  // one channel per path keeps delta tracking unbiased
-            channel = std::min(2, int(rng.uniform() * 3));
-            Color only(0);
-            only[channel] = power[channel] * 3;
-            power = only;
-            if (!(power[channel] > 0)) return;
-        }
+        // Chromatic extinction: spectral MIS from a hero channel, as the paths'.
+        HeroChannel spectral;
+        if (mChromatic) spectral.channel = std::min(2, int(rng.uniform() * 3));
         // Light emitted inside a medium is never direct: no shadow ray samples it.
-        follow(ctx, ep.ray, power, channel, !src.volume, src, rng, out);
+        follow(ctx, ep.ray, power, spectral, !src.volume, src, rng, out);
     }
 
 private:
     // Follows a photon of power `power` from ray.o: stored at every real
     // collision in a medium (eq. 4), absorbed or scattered by the albedo,
     // surfaces by the shared surface event (importance transport).
-    void follow(ThreadContext& ctx, Ray ray, const Color& power, int channel, bool direct, const PhotonSource& src,
+    void follow(ThreadContext& ctx, Ray ray, const Color& power, HeroChannel spectral, bool direct, const PhotonSource& src,
                 Rng& rng, std::vector<Photon>& out) const {
         const Scene& scene = mScene;
         const int maxDepth = scene.desc.render.maxDepth;
@@ -107,15 +102,21 @@ private:
             // Delta tracking to the next real collision; the photon is stored
             // there, then scatters with probability albedo.
             bool scattered = false, ended = false;
-            deltaTrack(ctx, region, ray, tEnd, channel, rng, [&](const Vec3& x, float sigmaMaj) {
+            deltaTrack(ctx, region, ray, tEnd, rng, [&](const Vec3& x, float sigmaMaj) {
                 evalMedia(ctx, region, x, mp);
-                float sa = trackedOrAverage(mp.sigma_a, channel), ss = trackedOrAverage(mp.sigma_s, channel);
-                if (rng.uniform() * sigmaMaj >= sa + ss) return true;  // null collision
-                float st = sa + ss;
+                const float sa = spectral.of(mp.sigma_a), ss = spectral.of(mp.sigma_s);
+                if (rng.uniform() * sigmaMaj >= sa + ss) {  // null collision
+                    if (spectral.channel < 0) return true;
+                    spectral.weigh(max(Color(sigmaMaj) - mp.sigma_t, Color(0)), beta);
+                    return !spectral.clearIn(scene.regions[size_t(region)].coefficients);
+                }
+                const float st = sa + ss;
                 Photon ph;
                 ph.position = x;
                 ph.direction = encodeDirection(ray.d);
-                ph.weight = power * beta / st;  // grey extinction: sigma_t is the same in every channel
+                // Phi / sigma_t: grey extinction's is the same in every
+                // channel; a chromatic one's is the channels' mixture.
+                ph.weight = power * beta / (spectral.channel < 0 ? st : spectral.mixed(mp.sigma_t));
                 float w[2];
                 mp.phase.legendreWeights(1, w);
                 ph.flags = Photon::packFlags((direct ? Photon::Direct : 0u) | (caustic ? Photon::Caustic : 0u) |
@@ -127,7 +128,10 @@ private:
                     ended = true;
                     return false;
                 }
-                if (channel < 0) beta *= mp.sigma_s / ss;  // per-channel albedo over its mean
+                if (spectral.channel < 0)
+                    beta *= mp.sigma_s / ss;  // per-channel albedo over its mean
+                else
+                    spectral.weigh(mp.sigma_s, beta);  // the collision and the scattering together
                 float pdf;
                 const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
                 ray = Ray{x, mp.phase.sample(ray.d, u0, u1, u2, beta, pdf)};

@@ -232,6 +232,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
         for (int mi : region.media) {
             const MediumDesc& md = desc.media[size_t(mi)];
             region.emits = region.emits || scene->media[size_t(mi)]->hasEmission;
+            region.coefficients += scene->media[size_t(mi)]->sigma_a + scene->media[size_t(mi)]->sigma_s;
             region.constant = region.constant && md.type == MediumDesc::Type::Homogeneous && !md.hasBounds &&
                               !scene->media[size_t(mi)]->hasEmission;
         }

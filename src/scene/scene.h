@@ -24,6 +24,9 @@ struct Region {
     // extinction is unboundedSigmaT everywhere in the region.
     bool constant = false;
     bool emits = false;  // some medium in it emits
+    // Summed sigma_a + sigma_s of its media: a channel that is zero here
+    // has no extinction anywhere in the region.
+    Color coefficients{0, 0, 0};
 };
 
 struct SurfaceInfo {

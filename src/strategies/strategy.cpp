@@ -8,14 +8,15 @@
 namespace vdbmarch {
 
 float trackingDensity(ThreadContext& ctx, const PathSegment& seg, float t, const MediumPoint& mp) {
-    float tau = 0;
+    Color tau(0);
     for (int mi : ctx.scene.regions[size_t(seg.region)].media) {
         float integral;
         if (!ctx.queries[size_t(mi)]->densityIntegral(seg.ray, 0.f, t, integral) || !(integral > 0)) continue;
         const Medium& m = *ctx.scene.media[size_t(mi)];
-        tau += trackedSigmaT(m.sigma_a + m.sigma_s, seg.channel) * integral;
+        tau += (m.sigma_a + m.sigma_s) * integral;
     }
-    return trackedOrAverage(mp.sigma_s, seg.channel) * std::exp(-tau);
+    if (seg.spectral.channel < 0) return average(mp.sigma_s) * std::exp(-tau.x);  // grey: one transmittance
+    return seg.spectral.mixed(mp.sigma_s * Color(std::exp(-tau.x), std::exp(-tau.y), std::exp(-tau.z)));
 }
 
 float distanceWeight(float pdfDistance, float pdfTracking) {

@@ -24,6 +24,7 @@
 #include "transport/roulette.h"
 #include "transport/surface_event.h"
 #include "transport/thread_context.h"
+#include "transport/tracking.h"
 #include "transport/transmittance.h"
 
 namespace vdbmarch {
@@ -32,7 +33,7 @@ namespace vdbmarch {
 struct PathSegment {
     Ray ray;
     int region = 0;
-    int channel = -1;       // tracked channel, < 0 for grey extinction
+    HeroChannel spectral;   // the path's spectral MIS state (channel < 0: grey extinction)
     float tEnd = 0;
     bool skipPointLights = false;  // photons carry point and spot lights' light (next-event estimation leaves them out)
 };
@@ -151,8 +152,9 @@ public:
 };
 
 // The density with which delta tracking makes a scattering collision at t,
-// for MIS weights only: sigma_s of the tracked channel times the
-// transmittance of the region's constant media (gridded media count as
+// for MIS weights only: sigma_s times the transmittance of the region's
+// constant media, mixed over the channels as spectral MIS mixes the
+// path's densities (HeroChannel) (gridded media count as
 // clear: an estimate of T is random, and a weight must be a function of t).
 float trackingDensity(ThreadContext& ctx, const PathSegment& seg, float t, const MediumPoint& mp);
 

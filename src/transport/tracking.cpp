@@ -4,13 +4,12 @@
 
 namespace vdbmarch {
 
-void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,
-                     std::vector<MajorantSegment>& out) {
+void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, std::vector<MajorantSegment>& out) {
     out.clear();
     const auto& media = ctx.scene.regions[size_t(region)].media;
     auto coefficient = [&](int mi) {
         const Medium& m = *ctx.scene.media[size_t(mi)];
-        return trackedSigmaT(m.sigma_a + m.sigma_s, channel);
+        return majorantSigmaT(m.sigma_a + m.sigma_s);
     };
     // Each medium's segments: its density bounds times its sigma_t.
     auto append = [&](int mi, std::vector<MajorantSegment>& to) {

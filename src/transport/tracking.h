@@ -16,16 +16,57 @@
 
 namespace vdbmarch {
 
-// Extinction used for tracking: channel c, or (grey media, channel < 0) channel 0.
-inline float trackedSigmaT(const Color& sigmaT, int channel) { return sigmaT[channel < 0 ? 0 : channel]; }
-
-// Tracking probabilities of the channel, or for grey extinction the channel
-// average (sigma_a + sigma_s sums to sigma_t either way).
-inline float trackedOrAverage(const Color& c, int channel) { return channel < 0 ? average(c) : c[channel]; }
+// The extinction a majorant bounds: the largest channel's, so that one
+// majorant serves every channel (for grey media, any channel's).
+inline float majorantSigmaT(const Color& sigmaT) { return maxComponent(sigmaT); }
 
 // True when some medium's extinction differs between channels: paths then
-// track one channel each, which keeps every estimator unbiased.
+// track with spectral MIS (HeroChannel).
 bool hasChromaticExtinction(const Scene& scene);
+
+// Spectral MIS for tracking in chromatic media (Miller, Georgiev and Jarosz
+// 2019, section 5; hero sampling of Wilkie et al. 2014): a path picks its
+// hero channel uniformly, decides each tentative collision (absorb,
+// scatter, null) by the hero's coefficients against the one majorant of
+// all channels, and every channel's throughput is weighed by the balance
+// heuristic over the three channels' path densities: f_c / mean_k p_k.
+// A collision event's f and p agree channel by channel (sigma_s or
+// sigma_maj - sigma_t), so a channel's weight is p_c / mean_k p_k <= 3:
+// no channel ever carries a firefly of its own, unlike one path per
+// channel. Grey extinction (channel < 0) keeps the channel average.
+struct HeroChannel {
+    int channel = -1;  // < 0: grey extinction, no spectral MIS
+    // Each channel's path density over their mean (averages 1).
+    Color pdf{1, 1, 1};
+
+    // Weighs beta by an event whose density in channel c is proportional
+    // to p[c]: beta *= p / mean(pdf p), pdf *= p / mean(pdf p).
+    void weigh(const Color& p, Color& beta) {
+        const Color q = pdf * p;
+        const float s = average(q);
+        if (!(s > 0)) return;  // an event the hero cannot draw (rounding at the majorant)
+        beta *= p / s;
+        pdf = q / s;
+        // A channel below 1e-20 of the mean carries nothing: flushed, so
+        // that it dies instead of lingering among the denormals (clearIn).
+        for (int c = 0; c < 3; ++c)
+            if (pdf[c] < 1e-20f) pdf[c] = 0, beta[c] = 0;
+    }
+    // The path density of an event whose density in channel c is
+    // proportional to p[c]: the channels' mixture mean(pdf p).
+    float mixed(const Color& p) const { return average(pdf * p); }
+    // True when no channel the path still carries (pdf > 0) has extinction
+    // in a region of these coefficients (Region::coefficients): every later
+    // null collision there would weigh by exactly 1, and tracking stops
+    // (a hero with no extinction in unbounded fog would never collide).
+    bool clearIn(const Color& coefficients) const {
+        for (int c = 0; c < 3; ++c)
+            if (pdf[c] > 0 && coefficients[c] > 0) return false;
+        return true;
+    }
+    // The hero's value of c, or for grey extinction the channel average.
+    float of(const Color& c) const { return channel < 0 ? average(c) : c[channel]; }
+};
 
 // A medium's extinction majorant from its density bound and coefficient.
 // evalMedia clamps each coefficient to MaxCoefficient, so the extinction
@@ -35,17 +76,15 @@ inline float mediumMajorant(float densityBound, float sigmaT) {
     return std::min(densityBound * sigmaT, 2 * MaxCoefficient);
 }
 
-// Combined extinction majorant of the region's media along [0, tEnd) for the
-// tracked `channel`.
-void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, int channel,
-                     std::vector<MajorantSegment>& out);
+// Combined extinction majorant of the region's media along [0, tEnd).
+void regionMajorants(ThreadContext& ctx, int region, const Ray& r, float tEnd, std::vector<MajorantSegment>& out);
 
 // Delta tracking along [0, tEnd) of `ray` in `region`: tentative collisions
 // are drawn at rate sigma_maj against the local majorants (walked lazily for
 // a single medium, so blocks past the first real collision are never
 // visited), and collide(x, sigmaMaj) is called at each until it returns false.
 template <typename Collide>
-void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int channel, Rng& rng, Collide&& collide) {
+void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, Rng& rng, Collide&& collide) {
     // `ray` is a copy: collide() may replace the caller's ray when it scatters.
     // A majorant of over a million collisions per march step (coefficients
     // near float's limits) would take steps below the resolution of t and
@@ -69,12 +108,12 @@ void deltaTrack(ThreadContext& ctx, int region, const Ray ray, float tEnd, int c
     const auto& media = ctx.scene.regions[size_t(region)].media;
     if (media.size() == 1) {
         const Medium& m = *ctx.scene.media[size_t(media[0])];
-        const float k = trackedSigmaT(m.sigma_a + m.sigma_s, channel);
+        const float k = majorantSigmaT(m.sigma_a + m.sigma_s);
         ctx.queries[size_t(media[0])]->forEachDensityBound(ray, 0.f, tEnd, [&](const DensityBound& s) {
             return track({s.t0, s.t1, mediumMajorant(s.maxDensity, k)});
         });
     } else if (!media.empty()) {
-        regionMajorants(ctx, region, ray, tEnd, channel, ctx.majorants);
+        regionMajorants(ctx, region, ray, tEnd, ctx.majorants);
         for (const auto& seg : ctx.majorants)
             if (!track(seg)) break;
     }
