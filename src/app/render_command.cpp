@@ -12,6 +12,7 @@
 
 #include "app/denoise_frame.h"
 #include "app/huge_page_heap.h"
+#include "app/method_pilot.h"
 #include "app/tiles.h"
 #include "app/vdb_check.h"
 #include "core/atomic_file.h"
@@ -148,7 +149,7 @@ uint64_t checkRenderMemory(const SceneDesc& desc, const PixelRect& window, bool 
 // Timings, counts and counters of a finished render (--stats).
 std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& scene, const RenderResult& r,
                       double loadSeconds, double total, uint64_t predictedMemory, double denoiseSeconds,
-                      double denoiseReserve) {
+                      double denoiseReserve, const std::optional<MethodPilot>& pilot) {
     const RenderCounters& c = r.counters;
     nlohmann::json s;
     s["seconds"] = {{"load", loadSeconds}, {"render", r.seconds}, {"photons_and_cache", r.illuminationSeconds},
@@ -161,6 +162,14 @@ std::string statsJson(const RenderArgs& a, const SceneDesc& desc, const Scene& s
     s["threads"] = r.threads;
     s["method"] = methodName(desc.render.method);
     s["method_auto"] = desc.render.methodAuto;
+    if (desc.render.methodAuto) s["method_reason"] = desc.render.methodReason;
+    if (pilot) {
+        nlohmann::json& p = s["method_pilots"] = nlohmann::json::array();
+        for (const PilotMeasurement& m : pilot->measured)
+            p.push_back({{"method", methodName(m.method)}, {"spp", m.samples}, {"seconds", m.seconds},
+                         {"setup_seconds", m.setupSeconds}, {"noise_rmse", m.rmse},
+                         {"predicted_noise_rmse", m.predictedRmse}});
+    }
     s["spp"] = r.spp;
     s["mean_spp"] = r.meanSpp;
     if (r.noise.valid)
@@ -389,7 +398,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (a.force && a.cache.empty()) throw InputError("--force only applies to --cache");
 
     if (!a.cache.empty()) checkVdbFilesIsolated({a.cache});  // a baked cache is a VDB file too
-    const SceneDesc desc = loadRenderScene(a, overrides, frame);
+    SceneDesc desc = loadRenderScene(a, overrides, frame);
     const TileRequest tile = parseTileRequest(a.tile, a.crop, a.passes);
     const PixelRect window = windowOf(tile, desc.camera.width, desc.camera.height);
     // The emitted part's sums, where a denoised render of the scene may keep them.
@@ -403,7 +412,18 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     Checkpointing checkpoint;
     checkpoint.path = a.resume.empty() ? a.checkpoint : a.resume;
     if (!checkpoint.path.empty()) setUpCheckpoints(a, desc, tile, window, checkpoint, options);
-    RenderResult r = renderImage(*scene, options);
+    // auto in a timed render of the whole frame: the method chosen by
+    // pilots (app/method_pilot.h).
+    std::optional<MethodPilot> pilot;
+    if (desc.render.methodAuto && options.timeBudget > 0 && !tile.any() && checkpoint.path.empty() && a.cache.empty())
+        pilot.emplace();
+    RenderResult r = pilot ? renderByPilots(*scene, options, *pilot) : renderImage(*scene, options);
+    if (pilot) {
+        desc.render.method = pilot->method;
+        desc.render.methodReason = scene->desc.render.methodReason =
+            str(pilot->reason, "; the rule: ", desc.render.methodReason);
+        if (!a.quiet) std::fprintf(stderr, "vdbmarch: %s\n", describePilot(*pilot).c_str());
+    }
     if (r.interrupted) {
         if (!a.quiet)
             std::fprintf(stderr, "vdbmarch: stopped by %s after %d samples per pixel; the state is in %s: run the "
@@ -424,7 +444,7 @@ int renderFrame(const RenderArgs& a, std::optional<int> frame) {
     if (!a.png.empty()) writePng(a.png, preview, desc.render.exposure);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!a.stats.empty()) writeTextFileAtomic(a.stats, statsJson(a, desc, *scene, r, loadSeconds, total, predictedMemory,
-                                                                  denoiseSeconds, options.reserveSeconds));
+                                                                  denoiseSeconds, options.reserveSeconds, pilot));
     if (!checkpoint.path.empty() && !a.keepCheckpoint) std::remove(checkpoint.path.c_str());  // the render is whole
     if (!a.quiet) printSummary(a, desc, *scene, tile, r, loadSeconds, total, denoiseSeconds);
     return 0;

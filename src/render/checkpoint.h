@@ -24,6 +24,9 @@ namespace vdbmarch {
 struct RenderCheckpoint {
     int nextSample = 0;
     double seconds = 0;   // the run's time so far (counts in --time)
+    // The first photons and cache, part of `seconds`, which a resumed render
+    // traces again (not kept in checkpoint files).
+    double setupSeconds = 0;
     RenderCounters counters;
     PixelSums sums{0};
     PhotonPassSums open;                    // the pass being rendered (pass -1: none)

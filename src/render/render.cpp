@@ -260,6 +260,7 @@ bool RenderState::checkpointAt(int next) {
     c.nextSample = next;
     c.seconds = std::chrono::duration<double>(now - runStart).count();
     c.counters = counters();
+    c.setupSeconds = firstIlluminationSeconds;
     saveCheckpoint(*hooks, c, film);
     lastCheckpoint = std::chrono::steady_clock::now();
     return stop;

@@ -52,6 +52,42 @@ TEST_F(TimeBudgetCli, ARenderNotDenoisedHereKeepsNothingBack) {
     }
 }
 
+// auto in a timed render picks by pilots (app/method_pilot.h): each
+// candidate's pilot is recorded with at least two samples per pixel, the
+// pick is one of them, and the image keeps the pick's pilot samples (the
+// render resumed from its pilot, so it has at least as many). Renders with
+// a method or a sample count run no pilot.
+TEST_F(TimeBudgetCli, AutoPicksByPilotsAndKeepsThePicksSamples) {
+    const nlohmann::json s = render("auto", {"--no-denoise"}, "2");
+    ASSERT_TRUE(s.contains("method_pilots")) << s.dump();
+    const nlohmann::json& pilots = s["method_pilots"];
+    ASSERT_GE(pilots.size(), 2u) << s.dump();
+    EXPECT_NE(pilots[0]["method"], pilots[1]["method"]);
+    const std::string method = s["method"];
+    int pilotSpp = -1;
+    for (int i = 0; i < 2; ++i) {
+        EXPECT_TRUE(pilots[i]["method"] == "reference" || pilots[i]["method"] == "guided") << pilots[i].dump();
+        EXPECT_GE(int(pilots[i]["spp"]), 2) << pilots[i].dump();
+        EXPECT_GT(double(pilots[i]["noise_rmse"]), 0) << pilots[i].dump();
+        if (pilots[i]["method"] == method) pilotSpp = pilots[i]["spp"];
+    }
+    ASSERT_GE(pilotSpp, 2) << "the pick is one of the pilots: " << s.dump();
+    EXPECT_GE(int(s["spp"]), pilotSpp);
+    EXPECT_NE(std::string(s["method_reason"]).find("the rule:"), std::string::npos) << s.dump();
+
+    EXPECT_FALSE(render("pinned", {"--no-denoise", "--method", "reference"}, "1").contains("method_pilots"));
+}
+
+TEST_F(TimeBudgetCli, ASampleCountRenderKeepsTheRule) {
+    const CliResult r = cli({"render", samplePath("cloud.json"), "-o", "spp.exr", "--res", "32x24", "--spp", "4",
+                             "--stats", "spp.json", "-q"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::ifstream in(work("spp.json"));
+    const nlohmann::json s = nlohmann::json::parse(in);
+    EXPECT_FALSE(s.contains("method_pilots")) << s.dump();
+    EXPECT_TRUE(bool(s["method_auto"]));
+}
+
 // The prediction is a measurement of this machine scaled by the pixel count:
 // positive, and a frame of 16 times the pixels is predicted to take longer.
 TEST(DenoisePrediction, GrowsWithThePixelCount) {
