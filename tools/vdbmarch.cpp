@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
                       "percentiles and p95/p50 of the per-pixel relative error |I-R|/(R+eps), eps = 1% of the "
                       "reference mean, where the reference's alpha >= 0.01: lower p95/p50 = more even quality), "
                       "bench.png, the cached reference")->required();
-    bench->add_option("--methods", ba.methods, "Comma-separated methods (default uniform,reference)");
+    bench->add_option("--methods", ba.methods, "Comma-separated methods, auto and vdb_render among them (default uniform,reference)");
     bench->add_option("--budgets", ba.budgets, "Comma-separated budgets: spp, or seconds with --seconds");
     bench->add_option("--vdb-render-steps", ba.vdbSteps,
                       "Steps in voxels for the method vdb_render (OpenVDB's renderer; default 4,2,1,0.5)");

@@ -11,6 +11,7 @@
 #include <functional>
 #include <sstream>
 
+#include "app/method_pilot.h"
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/rng.h"
@@ -19,6 +20,7 @@
 #include "image/metrics.h"
 #include "image/png_io.h"
 #include "core/transform.h"
+#include "parse/auto_method.h"
 #include "render/render.h"
 
 namespace vdbmarch {
@@ -175,6 +177,7 @@ namespace {
 struct BenchMethod {
     std::string name;
     bool vdbRender = false;
+    bool automatic = false;  // "auto": the rule's pick, by pilots in timed runs (app/method_pilot.h)
     Method method = Method::Reference;
     const std::vector<double>& budgets(const BenchOptions& o) const { return vdbRender ? o.vdbRenderSteps : o.budgets; }
 };
@@ -196,9 +199,9 @@ std::vector<BenchMethod> checkOptions(const BenchOptions& o, StripLayout& strip)
             throw InputError(str("bench: budget ", b, " must be a positive ", o.budgetSeconds ? "number of seconds" : "whole number of samples"));
     std::vector<BenchMethod> methods;
     for (const std::string& name : o.methods) {
-        BenchMethod m{name, name == "vdb_render"};
-        if (!m.vdbRender && !parseMethod(name, m.method))
-            throw InputError(str("bench: unknown method \"", name, "\" (", methodList(), " or vdb_render)"));
+        BenchMethod m{name, name == "vdb_render", name == "auto"};
+        if (!m.vdbRender && !m.automatic && !parseMethod(name, m.method))
+            throw InputError(str("bench: unknown method \"", name, "\" (", methodList(), ", auto or vdb_render)"));
         methods.push_back(m);
     }
     size_t most = 0;
@@ -212,12 +215,19 @@ std::vector<BenchMethod> checkOptions(const BenchOptions& o, StripLayout& strip)
 }
 
 // Renders `scene` with `method` at `spp` and `seed` (only the render
-// settings change between the bench's renders: the media load once).
-RenderResult renderWith(Scene& scene, Method method, int spp, uint64_t seed, const RenderOptions& ro) {
-    scene.desc.render.method = method;
+// settings change between the bench's renders: the media load once). `auto`
+// renders as `vdbmarch render` does: the rule's pick, or in a timed run
+// the pick of pilots, whose time counts.
+RenderResult renderWith(Scene& scene, const BenchMethod& method, int spp, uint64_t seed, RenderOptions ro) {
+    scene.desc.render.method = method.method;
     scene.desc.render.spp = spp;
     scene.desc.render.seed = seed;
-    return renderImage(scene, ro);
+    if (!method.automatic) return renderImage(scene, ro);
+    scene.desc.render.method = chooseMethod(scene.desc, scene.desc.render.methodReason);
+    if (!(ro.timeBudget > 0)) return renderImage(scene, ro);
+    ro.runStart = std::chrono::steady_clock::now();
+    MethodPilot pilot;
+    return renderByPilots(scene, ro, pilot);
 }
 
 // The reference: given, or the reference method at a high spp, cached in
@@ -245,7 +255,7 @@ Image benchReference(Scene& scene, const SceneDesc& baseScene, const BenchOption
     std::fprintf(stderr, "bench: rendering the reference (%d spp, method reference)...\n", o.referenceSpp);
     Image halves[2];
     for (int i = 0; i < 2; ++i)
-        halves[i] = renderWith(scene, Method::Reference, std::max(1, o.referenceSpp / 2), 1000003u + uint64_t(i), {}).image;
+        halves[i] = renderWith(scene, BenchMethod{"reference"}, std::max(1, o.referenceSpp / 2), 1000003u + uint64_t(i), {}).image;
     reference = Image(halves[0].width, halves[0].height);
     for (size_t i = 0; i < reference.rgba.size(); ++i) reference.rgba[i] = 0.5f * (halves[0].rgba[i] + halves[1].rgba[i]);
     result.referenceNoiseRmse = compareImages(halves[0], reference).rmse;
@@ -456,7 +466,7 @@ BenchResult runBench(const SceneDesc& baseScene, const BenchOptions& o) {
                 std::vector<double> times;
                 std::vector<RenderResult> runs;
                 for (int rep = 0; rep < std::max(1, o.repeats); ++rep) {
-                    runs.push_back(renderWith(*scene, method.method, spp, baseScene.render.seed, ro));
+                    runs.push_back(renderWith(*scene, method, spp, baseScene.render.seed, ro));
                     times.push_back(runs.back().seconds);
                 }
                 const RenderResult& med = runs[medianRun(times)];

@@ -15,7 +15,7 @@ int runBenchCommand(const BenchArgs& a) {
     o.methods = splitList(a.methods);
     for (const auto& m : o.methods) {
         Method known;
-        if (m != "vdb_render" && !parseMethod(m, known))
+        if (m != "vdb_render" && m != "auto" && !parseMethod(m, known))
             throw InputError(str("--methods: unknown method \"", m, "\""));
     }
     o.budgets = parseNumberList(a.budgets, "--budgets");

@@ -62,8 +62,31 @@ TEST(Bench, UnknownMethodIsRefusedBeforeAnyRender) {
     BenchOptions o = uniformAndReference(dir / "bench");
     o.methods = {"uniform", "guidd"};
     expectErrorContaining<InputError>([&] { runBench(smallCloud(), o); },
-                                      {"unknown method \"guidd\"", "reference", "vdb_render"});
+                                      {"unknown method \"guidd\"", "reference", "auto", "vdb_render"});
     EXPECT_TRUE(listDir(dir.path()).empty());
+}
+
+// auto as a benchmarked method renders as `vdbmarch render` does: at a
+// sample budget the rule's pick (the sample cloud's is the path tracer: the
+// same pixels, so the same error), in a timed run the pick of pilots, whose
+// time counts in its run's seconds.
+TEST(Bench, AutoIsTheRulesPickAtSampleBudgetsAndPilotsInTimedRuns) {
+    TempDir dir;
+    BenchOptions o = uniformAndReference(dir / "bench");
+    o.methods = {"auto", "reference"};
+    BenchResult spp = runBench(smallCloud(), o);
+    ASSERT_EQ(spp.rows.size(), 4u);
+    EXPECT_DOUBLE_EQ(spp.rows[0].rmse, spp.rows[2].rmse);
+    EXPECT_DOUBLE_EQ(spp.rows[1].rmse, spp.rows[3].rmse);
+
+    o.methods = {"auto"};
+    o.budgetSeconds = true;
+    o.budgets = {0.6};
+    BenchResult timed = runBench(smallCloud(), o);
+    ASSERT_EQ(timed.rows.size(), 1u);
+    EXPECT_GE(timed.rows[0].spp, 2);
+    EXPECT_GT(timed.rows[0].rmse, 0);
+    EXPECT_GT(timed.rows[0].seconds, 0.1);  // the pilots' time is in it
 }
 
 // vdb_render as a benchmarked method: runs with the scene translated to its
