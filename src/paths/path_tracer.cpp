@@ -306,16 +306,8 @@ PathWalk::Crossing PathWalk::track(const RaySegment& seg) {
             beta = Color(0);  // absorbed
             return false;
         }
-        if (u >= sa + ss) {  // null collision
-            if (spectral.channel < 0) return true;
-            spectral.weigh(max(Color(sigmaMaj) - mp.sigma_t, Color(0)), beta);
-            return !spectral.clearIn(scene.regions[size_t(region)].coefficients);
-        }
-        // Real scattering; weight sigma_s / (P_s sigma_maj) per channel.
-        if (spectral.channel < 0)
-            beta *= mp.sigma_s / ss;
-        else
-            spectral.weigh(mp.sigma_s, beta);
+        if (u >= sa + ss) return spectral.null(mp.sigma_t, sigmaMaj, scene.regions[size_t(region)].coefficients, beta);
+        spectral.scatter(mp.sigma_s, beta);  // real scattering
         scattered = scatterAt(x, dot(x - ray.o, ray.d), mp, path);
         return false;
     });

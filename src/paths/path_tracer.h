@@ -23,7 +23,6 @@
 // by the balance heuristic over the channels' densities.
 #pragma once
 
-#include <algorithm>
 #include <memory>
 
 #include "core/rng.h"
@@ -84,13 +83,6 @@ struct PathState {
     HeroChannel spectral;
 };
 
-// A path's starting spectral state: a hero channel drawn uniformly where
-// some medium's extinction differs between channels, else grey.
-inline HeroChannel startingHero(bool chromatic, Rng& rng) {
-    HeroChannel h;
-    if (chromatic) h.channel = std::min(2, int(rng.uniform() * 3));
-    return h;
-}
 
 // The path's first event, for the feature AOVs (render.aovs depth, albedo,
 // normal; docs/aovs.md): its first real collision in a medium or its first

@@ -68,8 +68,7 @@ public:
         power = ep.power / float(src.count);
         if (!(maxComponent(power) > 0) || !std::isfinite(maxComponent(power))) return;
         // Chromatic extinction: spectral MIS from a hero channel, as the paths'.
-        HeroChannel spectral;
-        if (mChromatic) spectral.channel = std::min(2, int(rng.uniform() * 3));
+        const HeroChannel spectral = startingHero(mChromatic, rng);
         // Light emitted inside a medium is never direct: no shadow ray samples it.
         follow(ctx, ep.ray, power, spectral, !src.volume, src, rng, out);
     }
@@ -105,11 +104,8 @@ private:
             deltaTrack(ctx, region, ray, tEnd, rng, [&](const Vec3& x, float sigmaMaj) {
                 evalMedia(ctx, region, x, mp);
                 const float sa = spectral.of(mp.sigma_a), ss = spectral.of(mp.sigma_s);
-                if (rng.uniform() * sigmaMaj >= sa + ss) {  // null collision
-                    if (spectral.channel < 0) return true;
-                    spectral.weigh(max(Color(sigmaMaj) - mp.sigma_t, Color(0)), beta);
-                    return !spectral.clearIn(scene.regions[size_t(region)].coefficients);
-                }
+                if (rng.uniform() * sigmaMaj >= sa + ss)  // null collision
+                    return spectral.null(mp.sigma_t, sigmaMaj, scene.regions[size_t(region)].coefficients, beta);
                 const float st = sa + ss;
                 Photon ph;
                 ph.position = x;
@@ -128,10 +124,7 @@ private:
                     ended = true;
                     return false;
                 }
-                if (spectral.channel < 0)
-                    beta *= mp.sigma_s / ss;  // per-channel albedo over its mean
-                else
-                    spectral.weigh(mp.sigma_s, beta);  // the collision and the scattering together
+                spectral.scatter(mp.sigma_s, beta);
                 float pdf;
                 const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
                 ray = Ray{x, mp.phase.sample(ray.d, u0, u1, u2, beta, pdf)};

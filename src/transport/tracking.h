@@ -64,6 +64,22 @@ struct HeroChannel {
             if (pdf[c] > 0 && coefficients[c] > 0) return false;
         return true;
     }
+    // A null collision (sigma_maj - sigma_t per channel) weighs beta;
+    // false where tracking can stop (clearIn).
+    bool null(const Color& sigmaT, float sigmaMaj, const Color& coefficients, Color& beta) {
+        if (channel < 0) return true;
+        weigh(max(Color(sigmaMaj) - sigmaT, Color(0)), beta);
+        return !clearIn(coefficients);
+    }
+    // A scattering collision: grey extinction weighs each channel by its
+    // albedo over the mean (the event was drawn by the mean), chromatic by
+    // sigma_s (the collision and the scattering together).
+    void scatter(const Color& sigmaS, Color& beta) {
+        if (channel < 0)
+            beta *= sigmaS / average(sigmaS);
+        else
+            weigh(sigmaS, beta);
+    }
     // The hero's value of c, or for grey extinction the channel average.
     float of(const Color& c) const { return channel < 0 ? average(c) : c[channel]; }
 };
@@ -74,6 +90,14 @@ struct HeroChannel {
 // sigma 1e30) finite, where an infinite majorant would stall tracking.
 inline float mediumMajorant(float densityBound, float sigmaT) {
     return std::min(densityBound * sigmaT, 2 * MaxCoefficient);
+}
+
+// A path's (or photon's) starting spectral state: a hero channel drawn
+// uniformly where some medium's extinction differs between channels, else grey.
+inline HeroChannel startingHero(bool chromatic, Rng& rng) {
+    HeroChannel h;
+    if (chromatic) h.channel = std::min(2, int(rng.uniform() * 3));
+    return h;
 }
 
 // Combined extinction majorant of the region's media along [0, tEnd).
