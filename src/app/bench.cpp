@@ -253,6 +253,13 @@ Image benchReference(Scene& scene, const SceneDesc& baseScene, const BenchOption
         return reference;
     }
     std::fprintf(stderr, "bench: rendering the reference (%d spp, method reference)...\n", o.referenceSpp);
+    // The truth is unbiased: sphere lights' caustics by paths, not photons.
+    struct PathCaustics {
+        Scene& s;
+        const bool was = s.sphereLightCausticPhotons;
+        ~PathCaustics() { s.sphereLightCausticPhotons = was; }
+    } pathCaustics{scene};
+    scene.sphereLightCausticPhotons = false;
     Image halves[2];
     for (int i = 0; i < 2; ++i)
         halves[i] = renderWith(scene, BenchMethod{"reference"}, std::max(1, o.referenceSpp / 2), 1000003u + uint64_t(i), {}).image;

@@ -6,10 +6,11 @@
 // channel (HeroChannel): one path per sample carries all three.
 //
 // A path cannot find a delta light through refracting glass (shadow rays
-// cannot bend): where a scene has such caustics, the photons flagged
-// caustic give them at the camera path's first medium vertex (eq. 4, the
-// progressive passes' radius), as they do at the guided marcher's L_i
-// samples; the paths give all the rest.
+// cannot bend), and finds a small sphere light through it only by chance:
+// where a scene has such caustics, the photons flagged caustic give them at
+// the camera path's first medium vertex (eq. 4, the progressive passes'
+// radius), as they do at the guided marcher's L_i samples; the paths give
+// all the rest (Scene::sphereLightCausticPhotons).
 #include "illumination/illumination.h"
 #include "estimators/estimator.h"
 #include "paths/path_tracer.h"
@@ -23,12 +24,13 @@ namespace {
 // L_caustic of eq. 4 over the current photon pass's caustic photons.
 class CausticPhotons final : public InScatteredLight {
 public:
-    explicit CausticPhotons(const Illumination& il) : mIl(il) {}
+    CausticPhotons(const Scene& scene, const Illumination& il) : mScene(scene), mIl(il) {}
     Color at(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const override {
-        return mIl.photonLi(x, region, wo, phase);
+        return mIl.photonLi(mScene, x, region, wo, phase);
     }
 
 private:
+    const Scene& mScene;
     const Illumination& mIl;
 };
 
@@ -36,7 +38,7 @@ class ReferenceTracer final : public Estimator {
 public:
     explicit ReferenceTracer(const EstimatorInputs& in)
         : mScene(in.scene), mChromatic(hasChromaticExtinction(in.scene)), mIllumination(in.illumination),
-          mCaustics(mIllumination && mIllumination->causticsOnly ? std::make_unique<CausticPhotons>(*mIllumination)
+          mCaustics(mIllumination && mIllumination->causticsOnly ? std::make_unique<CausticPhotons>(in.scene, *mIllumination)
                                                                  : nullptr),
           mPaths(in.scene, in.strategies, PathOptions{false, mCaustics.get()}) {}
 

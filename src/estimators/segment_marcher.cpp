@@ -78,7 +78,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
     const ScatterVertex vertex = ScatterVertex::inMedium(x, rayDir, mp.phase);
     // Eq. 4 over the photons the L_i source keeps (none: no photon map),
     // gathered within this photon pass's radius.
-    auto photons = [&] { return photonWeight > 0 ? photonWeight * il.photonLi(x, region, -rayDir, mp.phase) : Color(0); };
+    auto photons = [&] { return photonWeight > 0 ? photonWeight * il.photonLi(mScene, x, region, -rayDir, mp.phase) : Color(0); };
     auto direct = [&](const Color& Ld) {
         if (tallyHere) m.liDirect = Ld;
         return Ld;
@@ -133,6 +133,7 @@ Color SegmentMarcher::inScattered(ThreadContext& ctx, int region, const Vec3& x,
         state.lastPoint = x;
         state.connectedAtLast = connected;
         state.lastDir = wi;
+        state.causticPhotonsGathered = il.causticsOnly;  // photons() below
         if (pdf > 0) {
             state.spectral = startingHero(mChromatic, rng);
             const PathRadiance p = mPaths.trace(ctx, Ray{x, wi}, region, rng, state);

@@ -7,6 +7,7 @@
 #include "cache/cache_build.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "photons/kernel_volume.h"
 #include "photons/photon_tracer.h"
 #include "transport/surface_event.h"
 
@@ -63,10 +64,13 @@ bool refinesCacheAt(int pass) { return pass > 0 && ((pass + 1) & pass) == 0; }  
 
 }  // namespace
 
-Color Illumination::photonLi(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const {
+Color Illumination::photonLi(const Scene& scene, const Vec3& x, int region, const Vec3& wo,
+                             const PhaseMixture& phase) const {
     if (!indirect) return Color(0);
-    return indirect->estimateLi(x, wo, size_t(k), [&](float c) { return phase.eval(c); }, nullptr, radiusScale,
-                                region);
+    float radius = 0;
+    const Color L = indirect->estimateLi(x, wo, size_t(k), [&](float c) { return phase.eval(c); }, &radius,
+                                         radiusScale, region);
+    return isBlack(L) ? L : L / kernelFractionInside(scene, x, radius);
 }
 
 Illumination buildIllumination(const Scene& scene, const IlluminationRequest& rq) {
@@ -197,8 +201,9 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // Caustics of delta lights through refracting glass, which no path can
     // find, come from the caustic photons; through glass spheres, sphere
     // caustic connections find them where Scene::deltaLightCaustics holds.
+    // So do sphere lights' where Scene::sphereLightCausticPhotons holds.
     auto requestCaustics = [&] {
-        rq.indirect = bendingGlass && deltaLight && !scene.deltaLightCaustics;
+        rq.indirect = (bendingGlass && deltaLight && !scene.deltaLightCaustics) || scene.sphereLightCausticPhotons;
         rq.causticsOnly = true;
         rq.exceptConnected = scene.deltaLightCaustics;
     };

@@ -65,8 +65,9 @@ struct Illumination {
 
     // Eq. 4 at x (in medium region `region`) towards wo over the current
     // pass's map `indirect`, its k nearest photons of that region gathered
-    // within the pass's radius; 0 without a map.
-    Color photonLi(const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const;
+    // within the pass's radius, over the part of the sphere in the region
+    // (photons/kernel_volume.h); 0 without a map.
+    Color photonLi(const Scene& scene, const Vec3& x, int region, const Vec3& wo, const PhaseMixture& phase) const;
 };
 
 // The one path: traces photons when anything needs them, builds the kd-trees

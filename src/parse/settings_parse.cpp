@@ -103,7 +103,7 @@ RenderSettings parseRender(const JsonReader& r) {
 }
 
 ExperimentSettings parseExperiments(const JsonReader& r) {
-    r.allowOnly({"volume_sampling", "sphere_caustics", "beam_directions", "glass_splitting", "adaptive"});
+    r.allowOnly({"volume_sampling", "sphere_caustics", "beam_directions", "glass_splitting", "caustic_photons", "adaptive"});
     ExperimentSettings s;
     const std::string v = r.choice("volume_sampling", "mis", {"mis", "distance", "equiangular"});
     s.volumeSampling = v == "distance"      ? VolumeSampling::Distance
@@ -112,6 +112,7 @@ ExperimentSettings parseExperiments(const JsonReader& r) {
     s.sphereCaustics = r.boolean("sphere_caustics", s.sphereCaustics);
     s.beamDirections = r.boolean("beam_directions", s.beamDirections);
     s.glassSplitting = r.boolean("glass_splitting", s.glassSplitting);
+    s.causticPhotons = r.boolean("caustic_photons", s.causticPhotons);
     s.adaptive = r.boolean("adaptive", s.adaptive);
     return s;
 }

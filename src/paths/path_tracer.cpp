@@ -93,6 +93,9 @@ public:
     void hitLight(int light, float tEnd);
     float hitBackground();
     bool surfaceEvent(const SurfaceHit& h);
+    // The caustic photons gave the sphere lights this path meets through
+    // bending glass (PathState::causticPhotonsGathered).
+    bool leavesSphereLightsToPhotons() const { return st.causticPhotonsGathered && scene.sphereLightCausticPhotons; }
     // Russian roulette on the throughput after PathOptions::rouletteMinDepth events.
     bool roulette() {
         const PathOptions& o = tracer.mOptions;
@@ -183,6 +186,7 @@ bool PathWalk::scatterAt(Vec3 x, float t, const MediumPoint& mp, const PathSegme
     if (tracer.mOptions.firstVertexLight && st.firstVertexPending) {
         add(beta * tracer.mOptions.firstVertexLight->at(x, region, -ray.d, mp.phase), st.depth);
         st.firstVertexPending = false;
+        st.causticPhotonsGathered = true;
     }
     float pdf = 0;
     Vec3 wi;
@@ -203,6 +207,7 @@ bool PathWalk::scatterAt(Vec3 x, float t, const MediumPoint& mp, const PathSegme
 // against the connections through the specular chain since (power heuristic).
 void PathWalk::hitLight(int light, float tEnd) {
     meet(ray.at(tEnd));
+    if (st.specular && leavesSphereLightsToPhotons()) return;  // a caustic the photons gave
     const Light& l = scene.lights[size_t(light)];
     float w = 1;
     if (!st.specular) {
@@ -235,7 +240,8 @@ bool PathWalk::surfaceEvent(const SurfaceHit& h) {
     const float u[3] = {rng.uniform(), rng.uniform(), rng.uniform()};
     // A surface strategy may split a camera path at glass, or count the
     // light its reflection sees (strategies/glass_splitting.h).
-    const SurfaceRequest request{st.depth == 0 && st.glassSplits < SplitDielectricEvents, st.depth == 0};
+    const SurfaceRequest request{st.depth == 0 && st.glassSplits < SplitDielectricEvents, st.depth == 0,
+                                 leavesSphereLightsToPhotons()};
     const PathSurfaceEvent pe = strategies.surfaceEvent(ctx, h, ray.d, region, u, request, rng);
     add(beta * pe.light, st.depth);
     if (st.depth == startDepth) through += average(beta) * pe.backgroundSeen;

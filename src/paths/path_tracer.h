@@ -78,6 +78,11 @@ struct PathState {
     bool mirrorCounted = false;
     // PathOptions::firstVertexLight is still to be added.
     bool firstVertexPending = true;
+    // Caustic photons gave the light that reaches this path's vertices
+    // through bending glass (added at its first medium vertex, or at the
+    // march sample it starts from): where Scene::sphereLightCausticPhotons
+    // holds, the sphere lights it meets through such glass are left out.
+    bool causticPhotonsGathered = false;
     // Spectral MIS in chromatic media: the hero channel (< 0 for grey
     // extinction) and the channels' path densities (startingHero).
     HeroChannel spectral;

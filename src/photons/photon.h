@@ -47,7 +47,8 @@ struct Photon {
     enum Flags : uint32_t {
         Direct = 1u,   // straight from a light: shadow rays compute this light
         Caustic = 2u,  // from a delta light through a bending surface before any scattering:
-                       // no path with next-event estimation finds this light
+                       // no path with next-event estimation finds this light; from a sphere
+                       // light where Scene::sphereLightCausticPhotons leaves it to photons
         FromPointLight = 4u,  // emitted by a point or spot light
         // A caustic that sphere caustic connections find (Scene::deltaLightCaustics):
         // from a delta light through one glass sphere (in and out),

@@ -28,6 +28,9 @@ struct PhotonSource {
     int medium = -1;
     Color power{0, 0, 0};  // allocation weight
     bool deltaLight = false;  // a point, spot, directional or collimated light
+    // Its light bent by glass before any scattering is a caustic photon:
+    // delta lights always, sphere lights where Scene::sphereLightCausticPhotons.
+    bool causticsByPhotons = false;
     bool pointLight = false;  // a point or spot light
     size_t first = 0, count = 0;  // its range of path indices
 };
@@ -83,7 +86,7 @@ private:
         const int maxDepth = scene.desc.render.maxDepth;
         int region = regionAtRayStart(scene, ray);
         int depth = 0, surfaceBounces = 0;
-        bool caustic = false;  // bent before its first scattering event, from a delta light
+        bool caustic = false;  // bent before its first scattering event (PhotonSource::causticsByPhotons)
         // The events since emission while nothing scattered the photon:
         // refractions at one glass sphere (Photon::Connected after one,
         // across its surface, or two, through it), -1 once anything else
@@ -148,8 +151,9 @@ private:
             // it, so such photons stay direct.
             if (!e.straight) {
                 // Paths find a delta light only by next-event estimation at a
-                // scattering vertex, through straight shadow rays.
-                if (direct && src.deltaLight && e.kind != SurfaceEvent::Kind::Diffuse) caustic = true;
+                // scattering vertex, through straight shadow rays; sphere
+                // lights' caustics are left to photons where the scene says.
+                if (direct && src.causticsByPhotons && e.kind != SurfaceEvent::Kind::Diffuse) caustic = true;
                 direct = false;
                 followLensPattern(scene, e.kind == SurfaceEvent::Kind::Refract, h.surface, lensSphere, lensRefractions);
             }
@@ -221,14 +225,15 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
 
     std::vector<PhotonSource> sources;
     for (const Light& l : scene.lights) {
-        PhotonSource s{PhotonEmitter::forLight(l, target), nullptr, -1, Color(0), false, false, 0, 0};
+        PhotonSource s{PhotonEmitter::forLight(l, target), nullptr, -1, Color(0), false, false, false, 0, 0};
         s.power = s.emitter.power();
         s.deltaLight = l.isDelta();
+        s.causticsByPhotons = s.deltaLight || (l.sphere() && scene.sphereLightCausticPhotons);
         s.pointLight = l.isPointLike();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }
     if (!scene.environment.isBlack()) {
-        PhotonSource s{PhotonEmitter::forEnvironment(scene.environment, target), nullptr, -1, Color(0), false, false, 0, 0};
+        PhotonSource s{PhotonEmitter::forEnvironment(scene.environment, target), nullptr, -1, Color(0), false, false, false, 0, 0};
         s.power = s.emitter.power();
         if (maxComponent(s.power) > 0) sources.push_back(std::move(s));
     }
@@ -237,7 +242,7 @@ PhotonSet tracePhotons(const Scene& scene, size_t paths, uint64_t seed) {
         if (!m.hasEmission) continue;
         auto sampler = m.makeEmissionSampler();
         if (!sampler) continue;
-        PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), false, false, 0, 0};
+        PhotonSource s{PhotonEmitter::forEnvironment(Color(0), target), nullptr, int(mi), Color(0), false, false, false, 0, 0};
         s.power = m.blackbody ? m.sigma_a * m.emissionColor * sampler->blackbodyIntegral() * (4 * Pi)
                               : m.sigma_a * m.emissionColor * (4 * Pi * sampler->integralEstimate());
         s.volume = std::move(sampler);

@@ -123,6 +123,16 @@ void warnOfMissedCaustics(const Scene& scene) {
                             "reference must converge"));
 }
 
+// Scene::sphereLightCausticPhotons.
+bool gathersSphereLightCaustics(const Scene& scene) {
+    const ExperimentSettings& x = scene.desc.experiments;
+    if (!x.causticPhotons || !scene.hasSphereLights || !hasBendingGlass(scene)) return false;
+    if (x.sphereCaustics && !scene.glassSpheres.empty()) return false;
+    for (const auto& m : scene.media)
+        if (!m->isVacuum() && !isBlack(m->sigma_s)) return true;
+    return false;
+}
+
 // Scene::deltaLightCaustics.
 bool connectsDeltaLightCaustics(const Scene& scene) {
     if (!scene.desc.experiments.sphereCaustics) return false;
@@ -303,6 +313,7 @@ std::unique_ptr<Scene> buildScene(const SceneDesc& desc) {
     computeShadowReach(*scene);
     findGlassSpheres(*scene);
     scene->deltaLightCaustics = connectsDeltaLightCaustics(*scene);
+    scene->sphereLightCausticPhotons = gathersSphereLightCaustics(*scene);
     warnOfMissedCaustics(*scene);
     return scene;
 }

@@ -101,6 +101,14 @@ public:
     // the spheres' surfaces (inside one or outside all), every collimated
     // quad outside them (directional lights always are).
     bool deltaLightCaustics = false;
+    // The caustics of sphere lights through refracting glass come from
+    // caustic photons gathered at a path's first medium vertex, and the
+    // path leaves out every sphere light it reaches through bending glass
+    // from that vertex on (docs/method.md, "Caustics of sphere lights"):
+    // experiments.caustic_photons, a sphere light, bending glass, a
+    // scattering medium, and no glass sphere that sphere caustic
+    // connections already take (experiments.sphere_caustics).
+    bool sphereLightCausticPhotons = false;
 
     // Whether a shadow ray that starts in `region` can ever reach light
     // `light` (lights.size(): the environment). False only where every

@@ -38,7 +38,7 @@ bool GlassSplitting::sample(ThreadContext& ctx, const SurfaceHit& h, const Vec3&
     // What the reflection's first segment ends on.
     const RaySegment seg = nextRaySegment(scene, mirror.ray);
     Color Le(0);
-    if (seg.light >= 0)
+    if (seg.light >= 0 && !request.sphereLightsByPhotons)
         Le = scene.lights[size_t(seg.light)].emittedRadiance();
     else if (!seg.hitSurface)
         Le = request.seenFromCamera ? scene.environment.radianceSeen(mirror.ray.d)

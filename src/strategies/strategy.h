@@ -139,6 +139,7 @@ struct PathSurfaceEvent {
 struct SurfaceRequest {
     bool split = false;           // the path may follow both outcomes here (a camera path's first glass events)
     bool seenFromCamera = false;  // the path has not scattered yet (it sees the environment map as a backdrop)
+    bool sphereLightsByPhotons = false;  // caustic photons gave the sphere lights glass shows this path
 };
 
 class SurfaceStrategy {

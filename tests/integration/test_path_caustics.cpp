@@ -10,6 +10,8 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "illumination/illumination.h"
+#include "photons/photon_tracer.h"
 #include "render/render.h"
 #include "scene/scene.h"
 #include "support/support.h"
@@ -87,6 +89,88 @@ TEST(PathCaustics, ThePathTracerSeesAPointLightThroughAGlassMesh) {
 TEST(PathCaustics, MultipleScatteringOfTheSunThroughAGlassMesh) {
     expectCausticsAsTheMarcher(R"({"type": "directional", "direction": [-0.4, -1, -0.3], "irradiance": [3, 3, 3]})",
                                4, 32);
+}
+
+// Sphere lights' caustics (Scene::sphereLightCausticPhotons): a sphere light
+// outside the glass icosahedron, thin fog around it. The photons give all
+// the light the paths would find through the glass, in the smoke and in the
+// fog, and the paths leave it out from the vertex that gathered them on; the
+// image has the expectation of the paths alone (experiments.caustic_photons
+// false, unbiased) up to the photons' blur, which the passes shrink.
+std::string writeSphereLightScene(int count, const std::string& fog) {
+    test::writeIcosahedron(workDir() + "/ico.obj");
+    const std::string file = workDir() + "/sphere_light.json";
+    std::ofstream(file) << R"({
+  "camera": {"position": [0, 0.2, 3], "look_at": [0, 0, 0], "fov_deg": 40, "resolution": [32, 24]},
+  "lights": [{"type": "sphere", "position": [1.2, 1.4, 0.6], "radius": 0.4, "power": [40, 40, 40]}],
+  "media": [{"name": "fog", "type": "homogeneous", "sigma_a": 0.01, "sigma_s": )" + fog + R"(, "g": 0.2,
+             "bounds": {"min": [-2, -1.5, -2], "max": [2, 2, 2]}},
+            {"name": "smoke", "type": "homogeneous", "sigma_a": 0.1, "sigma_s": 1.5, "g": 0.3}],
+  "surfaces": [{"shape": "mesh", "file": "ico.obj", "smooth_normals": false, "transform": {"scale": 0.8},
+                "material": {"type": "dielectric", "ior": 1.5}, "interior": "smoke"}],
+  "background": 0,
+  "photons": {"count": )" + std::to_string(count) + R"(, "k": 30, "seed": 5},
+  "render": {"max_depth": 6, "seed": 7, "step": 0.02}
+})";
+    return file;
+}
+
+Image renderSphereLight(Method method, int spp, uint64_t seed, bool causticPhotons, int count, const std::string& fog) {
+    const std::string file = writeSphereLightScene(count, fog);
+    SceneDesc d = loadSceneFile(file, {str("render.spp=", spp), str("render.seed=", seed),
+                                       str("experiments.caustic_photons=", causticPhotons ? "true" : "false")});
+    d.render.method = method;
+    const auto scene = buildScene(d);
+    EXPECT_EQ(scene->sphereLightCausticPhotons, causticPhotons);
+    return renderImage(*scene).image;
+}
+
+// The photons that bring a sphere light into the smoke all passed the glass:
+// flagged caustic with experiments.caustic_photons, none without, and the
+// reference then asks for the caustic map.
+TEST(PathCaustics, SphereLightPhotonsThroughGlassAreCaustic) {
+    const std::string file = writeSphereLightScene(20000, "0");
+    for (bool on : {true, false}) {
+        const auto scene = buildScene(loadSceneFile(file,
+                                                    {str("experiments.caustic_photons=", on ? "true" : "false")}));
+        const int smoke = scene->surfaces[0].interiorRegion;
+        size_t inSmoke = 0, caustic = 0;
+        for (const Photon& p : tracePhotons(*scene, 20000, 5).photons) {
+            if (p.region() != smoke) continue;
+            ++inSmoke;
+            caustic += p.isCaustic();
+        }
+        EXPECT_GT(inSmoke, 100u);
+        EXPECT_EQ(caustic, on ? inSmoke : 0u);
+        EXPECT_EQ(illuminationRequest(*scene, Method::Reference).indirect, on);
+    }
+}
+
+// Without fog every pixel's light is a caustic: counted twice it would
+// double the image, left out it would be black. With fog, the light the
+// glass throws into the fog and the light the fog sees through the glass are
+// left to photons too. The image means agree with the paths' within 4
+// standard errors of the difference.
+void expectSphereLightCausticsAsThePaths(Method method, int spp, const std::string& fog) {
+    const Image paths = renderSphereLight(Method::Reference, 16 * spp, 1, false, 0, fog);
+    const Image photons = renderSphereLight(method, spp, 2, true, 4000, fog);
+    const MeanAndError p = meanOf(paths), q = meanOf(photons);
+    EXPECT_GT(p.mean, 10 * p.error);
+    const double error = std::hypot(p.error, q.error);
+    EXPECT_NEAR(q.mean, p.mean, 4 * error) << "paths " << p.mean << " +- " << p.error << ", photons " << q.mean
+                                           << " +- " << q.error;
+}
+
+TEST(PathCaustics, SphereLightCausticsFromPhotonsHaveThePathsExpectation) {
+    expectSphereLightCausticsAsThePaths(Method::Reference, 128, "0");
+}
+
+TEST(PathCaustics, TheGuidedMarchersContinuationsLeaveSphereLightCausticsToPhotons) {
+    expectSphereLightCausticsAsThePaths(Method::Guided, 32, "0");
+}
+
+TEST(PathCaustics, SphereLightCausticsInFogAroundTheGlass) {
+    expectSphereLightCausticsAsThePaths(Method::Reference, 64, "0.3");
 }
 
 }  // namespace
