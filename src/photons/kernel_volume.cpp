@@ -32,7 +32,7 @@ uint64_t bitsOf(const Vec3& x) {
 }  // namespace
 
 float kernelFractionInside(const Scene& scene, const Vec3& x, float radius) {
-    if (!scene.surfaceSet || scene.surfaceSet->bounds().empty() || !(radius > 0) || !std::isfinite(radius)) return 1;
+    if (scene.surfaces.empty() || !scene.surfaceSet || !(radius > 0) || !std::isfinite(radius)) return 1;
     Rng rng(bitsOf(x), 0x6b65726e656cULL);
     double sum = 0;
     // A uniform rotation: a uniform axis for z, a uniform angle about it.
