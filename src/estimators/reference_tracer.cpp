@@ -6,11 +6,11 @@
 // channel (HeroChannel): one path per sample carries all three.
 //
 // A path cannot find a delta light through refracting glass (shadow rays
-// cannot bend), and finds a small sphere light through it only by chance:
-// where a scene has such caustics, the photons flagged caustic give them at
-// the camera path's first medium vertex (eq. 4, the progressive passes'
-// radius), as they do at the guided marcher's L_i samples; the paths give
-// all the rest (Scene::sphereLightCausticPhotons).
+// cannot bend): where a scene has such caustics, the photons flagged
+// caustic give them at the camera path's first medium vertex (eq. 4, the
+// progressive passes' radius), as they do at the guided marcher's L_i
+// samples; the paths give all the rest. Sphere lights stay with the paths
+// unless those photons carry them too (Scene::sphereLightCausticPhotons).
 #include "illumination/illumination.h"
 #include "estimators/estimator.h"
 #include "paths/path_tracer.h"

@@ -201,15 +201,19 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // Caustics of delta lights through refracting glass, which no path can
     // find, come from the caustic photons; through glass spheres, sphere
     // caustic connections find them where Scene::deltaLightCaustics holds.
-    // So do sphere lights' where Scene::sphereLightCausticPhotons holds.
-    auto requestCaustics = [&] {
-        rq.indirect = (bendingGlass && deltaLight && !scene.deltaLightCaustics) || scene.sphereLightCausticPhotons;
+    // So do sphere lights' where Scene::sphereLightCausticPhotons holds, for
+    // the marchers: the reference keeps its paths for them (unbiased, and
+    // photon passes every few samples hold back its timed adaptive sampling
+    // where most pixels see no glass; docs/method.md).
+    auto requestCaustics = [&](bool sphereLights) {
+        rq.indirect = (bendingGlass && deltaLight && !scene.deltaLightCaustics) ||
+                      (sphereLights && scene.sphereLightCausticPhotons);
         rq.causticsOnly = true;
         rq.exceptConnected = scene.deltaLightCaustics;
     };
     if (method == Method::Reference) {  // paths, and photons for what they cannot find; render.li does not apply
         if (!options.cacheFile.empty()) warn(str(options.cacheFile, ": the reference tracer does not read a cache; ignored"));
-        requestCaustics();
+        requestCaustics(false);
         return rq;
     }
     rq.cache = methodUsesCache(method, rs);
@@ -228,7 +232,7 @@ IlluminationRequest illuminationRequest(const Scene& scene, Method method, const
     // carry their multiply scattered light too.
     if (rs.li == LiSource::Photons) rq.indirect = rs.maxDepth > 1 || bendingGlass;
     if (rs.li == LiSource::Path) {
-        requestCaustics();
+        requestCaustics(true);
         rq.indirect = rq.indirect || (pointLight && rs.maxDepth > 1);
         rq.pointLightsByPhotons = pointLight && rq.indirect;
     }
