@@ -313,7 +313,7 @@ def main():
 
     # Keys that only steer vdbmarch's sampling (its converged image does not depend on them).
     check_keys(sc, {"camera", "lights", "media", "surfaces", "background", "render",
-                    "experiments", "photons", "cache"}, "scene")
+                    "experiments", "photons", "cache", "environment"}, "scene")
 
     def resolve(p):
         if "#" in p:
@@ -384,6 +384,9 @@ def main():
             os.makedirs(nvdb_dir, exist_ok=True)
             dst = os.path.join(nvdb_dir, os.path.splitext(os.path.basename(src))[0] + ".nvdb")
             if not (os.path.exists(dst) and os.path.getmtime(dst) >= os.path.getmtime(src)):
+                if not os.access(a.nanovdb_convert, os.X_OK):
+                    die("%s.file: needs nanovdb_convert (--nanovdb-convert), not found at %s"
+                        % (p, a.nanovdb_convert))
                 r = subprocess.run([a.nanovdb_convert, "-f", src, dst], capture_output=True, text=True)
                 if r.returncode != 0:
                     die("%s.file: nanovdb_convert %s failed: %s" % (p, src, r.stderr.strip()))
