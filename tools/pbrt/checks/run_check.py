@@ -4,7 +4,8 @@ independent halves each), compare the per-channel image means, and, where there 
 form.
 
     run_check.py NAME [NAME ...]      NAME: sun_plane, absorb_box, absorb_colour, single_scatter,
-                                            sphere_light, glass_medium, or all
+                                            sphere_light, glass_medium,
+                                            vdb_cloud, or all
 
 Environment: VDBMARCH (default /tmp/pbrt_peer/vdbmarch), PBRT_BUILD (/tmp/pbrt-v4-build),
 EXRSTAT (/tmp/pbrt_peer/exrstat, built from ../exrstat.cpp), OUT (/tmp/pbrt_peer/checks),
@@ -110,6 +111,17 @@ def scenes():
                        "material": {"type": "diffuse", "albedo": 0.6}}],
          "render": {"max_depth": 64}},
         None, 1024, 1024, None)
+    # (f) the sample cloud as a vdb medium, moved by a transform, under a sun and a constant sky
+    vdb = os.path.normpath(os.path.join(HERE, "..", "..", "..", "vdb_samples", "cloud.vdb"))
+    S["vdb_cloud"] = (
+        {"camera": {"position": [1.47, 0.88, 3.25], "look_at": [0, 0.17, 0], "fov_deg": 35,
+                    "resolution": [64, 48]},
+         "lights": [{"type": "directional", "direction": [0.55, -0.75, -0.35], "irradiance": [6.4, 6.0, 5.4]}],
+         "media": [{"name": "cloud", "type": "vdb", "file": vdb, "sigma_a": 0.3, "sigma_s": 6.0, "g": 0.2,
+                    "transform": {"scale": 0.8, "rotate": [0, 1, 0, 30], "translate": [0, 0.1, 0]}}],
+         "background": [0.18, 0.26, 0.42],
+         "render": {"max_depth": 64}},
+        None, 256, 256, None)
     return S
 
 
