@@ -5,7 +5,8 @@
                         [--max-depth N] [--seed N] [--nanovdb-convert PATH] [--nvdb-dir DIR]
 
 VDB media are converted to .nvdb (NanoVDB 32.3, the version pbrt-v4 reads) with nanovdb_convert
-(default /tmp/pbrt-v4-build/nanovdb_convert), next to OUT.pbrt unless --nvdb-dir says otherwise.
+(default /tmp/pbrt-v4-build/nanovdb_convert), and a lat-long environment map to pbrt's equal-area
+square map with pbrt's `imgtool makeequiarea`, next to OUT.pbrt unless --nvdb-dir says otherwise.
 Anything the converter cannot map faithfully exits with status 1 and a message naming the key
 (docs/pbrt-peer.md lists the mapping). Warnings go to stderr.
 
@@ -19,6 +20,8 @@ so an "rgb L/I" of [1 1 1] is radiance/intensity 1 in the output's linear sRGB u
   directional "distant" to = direction, rgb L = irradiance
   sphere      sphere shape with a "diffuse" area light, rgb L = power / (4 pi^2 r^2), black material
   background  "infinite" rgb L = background
+  environment imgtool makeequiarea, "infinite" filename, scale; light transform Rotate(rotation, y)
+              times the axis change from vdbmarch's lat-long (+y up, u=0 along -z) to pbrt's (+z up)
   homogeneous MakeNamedMedium "homogeneous" (sigma_a, sigma_s, g as given, RGB uplifted to spectra)
   vdb         MakeNamedMedium "nanovdb" under the medium's transform, "scale" = density_scale
   media       world media with bounds (or a vdb grid's bounding box) get an enclosing box with
@@ -298,7 +301,8 @@ def main():
     ap.add_argument("--max-depth", type=int, help="pbrt maxdepth (default: render.max_depth)")
     ap.add_argument("--seed", type=int)
     ap.add_argument("--nanovdb-convert", default="/tmp/pbrt-v4-build/nanovdb_convert")
-    ap.add_argument("--nvdb-dir", help="where converted .nvdb files go (default: OUT's folder)")
+    ap.add_argument("--imgtool", default="/tmp/pbrt-v4-build/imgtool")
+    ap.add_argument("--nvdb-dir", help="where converted .nvdb and environment files go (default: OUT's folder)")
     a = ap.parse_args()
 
     with open(a.scene) as fh:
@@ -576,11 +580,34 @@ def main():
         else:
             die("%s.type: %r is not supported" % (p, t))
 
-    if "environment" in sc:
-        die("environment: lat-long maps are not converted (pbrt-v4's image light needs an "
-            "equal-area square map and its orientation is not checked here)")
     bg = colour(sc.get("background"), "background", 0)
-    if max(bg) > 0:
+    if "environment" in sc:
+        env = sc["environment"]
+        check_keys(env, {"file", "scale", "rotation"}, "environment")
+        if max(bg) > 0:
+            die("background: a non-black background together with environment")
+        if "file" not in env:
+            die("environment.file: required")
+        src = resolve(env["file"])
+        os.makedirs(nvdb_dir, exist_ok=True)
+        dst = os.path.join(nvdb_dir, os.path.splitext(os.path.basename(src))[0] + "_equiarea.exr")
+        if not (os.path.exists(dst) and os.path.getmtime(dst) >= os.path.getmtime(src)):
+            if not os.access(a.imgtool, os.X_OK):
+                die("environment.file: needs pbrt's imgtool (--imgtool), not found at %s" % a.imgtool)
+            r = subprocess.run([a.imgtool, "makeequiarea", src, "--outfile", dst], capture_output=True, text=True)
+            if r.returncode != 0:
+                die("environment.file: imgtool makeequiarea %s failed: %s" % (src, r.stderr.strip()))
+        # vdbmarch: texel (u, v) looks along (sin t sin p, cos t, -sin t cos p), t = pi v, p = 2 pi u;
+        # pbrt's makeequiarea puts it at light-space (sin t cos p, sin t sin p, cos t): world x = light y,
+        # world y = light z, world z = -light x; then the map's rotation about +y (right-handed).
+        Mw = [[0, 1, 0, 0], [0, 0, 1, 0], [-1, 0, 0, 0], [0, 0, 0, 1]]
+        lines_l.append("AttributeBegin  # environment: %s as an equal-area map" % src)
+        lines_l.append("  Rotate %s 0 1 0" % f(num(env.get("rotation"), "environment.rotation", 0.0)))
+        lines_l.append("  " + pbrt_transform(Mw))
+        lines_l.append('  LightSource "infinite" "string filename" "%s" "float scale" %s'
+                       % (dst, f(num(env.get("scale"), "environment.scale", 1.0))))
+        lines_l.append("AttributeEnd")
+    elif max(bg) > 0:
         lines_l.append('LightSource "infinite" "rgb L" [ %s ]' % fl(bg))
 
     # -------------------------------------------------------------- write

@@ -5,7 +5,7 @@ form.
 
     run_check.py NAME [NAME ...]      NAME: sun_plane, absorb_box, absorb_colour, single_scatter,
                                             sphere_light, glass_medium,
-                                            vdb_cloud, or all
+                                            vdb_cloud, env_sky, or all
 
 Environment: VDBMARCH (default /tmp/pbrt_peer/vdbmarch), PBRT_BUILD (/tmp/pbrt-v4-build),
 EXRSTAT (/tmp/pbrt_peer/exrstat, built from ../exrstat.cpp), OUT (/tmp/pbrt_peer/checks),
@@ -121,6 +121,15 @@ def scenes():
                     "transform": {"scale": 0.8, "rotate": [0, 1, 0, 30], "translate": [0, 0.1, 0]}}],
          "background": [0.18, 0.26, 0.42],
          "render": {"max_depth": 64}},
+        None, 256, 256, None)
+    # (g) the bundled lat-long sky (sun disc) turned by 40 degrees, seen behind a white diffuse ball
+    sky = os.path.normpath(os.path.join(HERE, "..", "..", "..", "vdb_samples", "sky.exr"))
+    S["env_sky"] = (
+        {"camera": {"position": [0, 0.3, 3], "look_at": [0, 0, 0], "fov_deg": 40, "resolution": [64, 48]},
+         "environment": {"file": sky, "rotation": 40},
+         "surfaces": [{"shape": "sphere", "transform": {"scale": 0.5},
+                       "material": {"type": "diffuse", "albedo": 0.8}}],
+         "render": {"max_depth": 1}},
         None, 256, 256, None)
     return S
 
