@@ -15,7 +15,7 @@ so an "rgb L/I" of [1 1 1] is radiance/intensity 1 in the output's linear sRGB u
   camera      Scale -1 1 1 + LookAt (pbrt is left-handed: without the mirror the image is flipped
               left-right); "fov" spans the shorter image axis, vdbmarch's fov_deg is vertical.
   point       "point" rgb I = intensity
-  spot        "spot" rgb I = intensity, coneangle = cone_deg, conedelta = falloff_deg (both
+  spot        "spot" rgb I = intensity, coneangle = cone_deg, conedeltaangle = falloff_deg (both
               renderers use a smoothstep in the cosine over the same band)
   directional "distant" to = direction, rgb L = irradiance
   sphere      sphere shape with a "diffuse" area light, rgb L = power / (4 pi^2 r^2), black material
@@ -551,7 +551,7 @@ def main():
             fall = num(L.get("falloff_deg"), p + ".falloff_deg", min(5.0, cone))
             I = colour(L.get("intensity"), p + ".intensity", 1)
             lines_l.append('LightSource "spot" "point3 from" [ %s ] "point3 to" [ %s ] "rgb I" [ %s ]'
-                           ' "float coneangle" %s "float conedelta" %s'
+                           ' "float coneangle" %s "float conedeltaangle" %s'
                            % (fl(pos), fl(add(pos, dr)), fl(I), f(cone), f(fall)))
             delta_lights += 1
         elif t == "directional":

@@ -4,7 +4,7 @@ independent halves each), compare the per-channel image means, and, where there 
 form.
 
     run_check.py NAME [NAME ...]      NAME: sun_plane, absorb_box, absorb_colour, single_scatter,
-                                            sphere_light, glass_medium,
+                                            sphere_light, point_spot, glass_medium,
                                             vdb_cloud, env_sky, or all
 
 Environment: VDBMARCH (default /tmp/pbrt_peer/vdbmarch), PBRT_BUILD (/tmp/pbrt-v4-build),
@@ -111,6 +111,16 @@ def scenes():
                        "material": {"type": "diffuse", "albedo": 0.6}}],
          "render": {"max_depth": 64}},
         None, 1024, 1024, None)
+    # (d') a point light and a soft-edged spot light over a diffuse plane (intensity, cone, falloff)
+    S["point_spot"] = (
+        {"camera": plane_cam(),
+         "lights": [{"type": "point", "position": [-0.8, 1.0, 0.3], "intensity": [3, 2.5, 2]},
+                    {"type": "spot", "position": [0.7, 1.5, -0.2], "direction": [-0.2, -1, 0.1],
+                     "intensity": 6, "cone_deg": 25, "falloff_deg": 8}],
+         "surfaces": [{"shape": "box", "transform": {"scale": [40, 0.1, 40], "translate": [0, -0.05, 0]},
+                       "material": {"type": "diffuse", "albedo": 0.7}}],
+         "render": {"max_depth": 1}},
+        None, 64, 64, None)
     # (f) the sample cloud as a vdb medium, moved by a transform, under a sun and a constant sky
     vdb = os.path.normpath(os.path.join(HERE, "..", "..", "..", "vdb_samples", "cloud.vdb"))
     S["vdb_cloud"] = (
