@@ -29,7 +29,9 @@ so an "rgb L/I" of [1 1 1] is radiance/intensity 1 in the output's linear sRGB u
               interior exterior, exterior = the world medium whose bounds hold the surface
   surfaces    box/mesh -> world-space trianglemesh oriented outwards, sphere -> "sphere" under the
               transform (p' = T R S p), diffuse -> "diffuse" reflectance, dielectric -> eta, interface
-  render      spp -> zsobol pixelsamples, max_depth -> volpath maxdepth, box pixel filter
+  render      spp -> zsobol pixelsamples, max_depth -> volpath maxdepth, box pixel filter; upstream
+              pbrt counts glass bounces in maxdepth, vdbmarch does not: --specular-depth N with the
+              patched pbrt (patches/volpath_maxspeculardepth.patch) counts them apart, as vdbmarch
 """
 import argparse
 import json
@@ -300,6 +302,10 @@ def main():
     ap.add_argument("--spp", type=int)
     ap.add_argument("--max-depth", type=int, help="pbrt maxdepth (default: render.max_depth)")
     ap.add_argument("--seed", type=int)
+    ap.add_argument("--specular-depth", type=int, metavar="N",
+                    help="needs pbrt with patches/volpath_maxspeculardepth.patch: glass bounces do not count "
+                         "towards maxdepth (as in vdbmarch) and a path ends after N of them (vdbmarch's "
+                         "max_surface_bounces, 32 by default, is the match)")
     ap.add_argument("--nanovdb-convert", default="/tmp/pbrt-v4-build/nanovdb_convert")
     ap.add_argument("--imgtool", default="/tmp/pbrt-v4-build/imgtool")
     ap.add_argument("--nvdb-dir", help="where converted .nvdb and environment files go (default: OUT's folder)")
@@ -616,7 +622,7 @@ def main():
     if has_glass and delta_lights:
         warn("a point/spot/directional light with refracting glass: pbrt's volpath cannot carry a "
              "delta light through glass (vdbmarch adds those caustics from photons)")
-    if has_glass and not a.max_depth:
+    if has_glass and not a.max_depth and a.specular_depth is None:
         warn("pbrt's maxdepth also counts glass reflections/refractions, vdbmarch's max_depth does not: "
              "paths through glass are cut earlier in pbrt (raise it with --max-depth)")
 
@@ -629,7 +635,8 @@ def main():
     o.append("LookAt %s   %s   %s" % (fl(eye), fl(look), fl(up)))
     o.append('Camera "perspective" "float fov" %s' % f(fov))
     o.append('Sampler "zsobol" "integer pixelsamples" %d "integer seed" %d' % (spp, seed % 2147483647))
-    o.append('Integrator "volpath" "integer maxdepth" %d' % pbrt_depth)
+    o.append('Integrator "volpath" "integer maxdepth" %d' % pbrt_depth
+             + ('' if a.specular_depth is None else ' "integer maxspeculardepth" %d' % a.specular_depth))
     o.append('Film "rgb" "integer xresolution" %d "integer yresolution" %d "string filename" "%s"'
              ' "bool savefp16" false' % (W, H, image))
     o.append('PixelFilter "box"' + ("" if jitter else ' "float xradius" 0.0001 "float yradius" 0.0001'))
