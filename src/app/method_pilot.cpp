@@ -46,8 +46,7 @@ Stage renderStage(const Scene& scene, RenderOptions o, const RenderCheckpoint* f
 // rendered is summed apart until it closes.
 NoiseEstimate noiseOf(const RenderCheckpoint& c, double& meanSamples) {
     if (c.nextSample < 2) return {};
-    PixelSums all = c.sums;
-    if (c.open.pass >= 0) all.fold(c.open);
+    const PixelSums all = c.sums.withOpen(c.open);
     double n = 0;
     for (size_t p = 0; p < all.L.size(); ++p) n += all.samplesOf(p);
     meanSamples = n / double(std::max<size_t>(1, all.L.size()));

@@ -60,6 +60,13 @@ struct PixelSums {
     std::vector<int> convergedAt;
     explicit PixelSums(size_t pixels) : L(pixels, Color(0)), T(pixels, 0.0), oddL(pixels, Color(0)), oddT(pixels, 0.0) {}
     void fold(const PhotonPassSums& pass);
+    // These sums with `open`, the photon pass still being rendered (pass -1:
+    // none), folded in: the frame as it would be if that pass closed now.
+    PixelSums withOpen(const PhotonPassSums& open) const {
+        PixelSums all = *this;
+        if (open.pass >= 0) all.fold(open);
+        return all;
+    }
     // Samples in pixel p's sums.
     int samplesOf(size_t p) const { return convergedAt.empty() || convergedAt[p] == 0 ? samples : convergedAt[p]; }
     // RGB = L / samples, alpha = 1 - T / samples.

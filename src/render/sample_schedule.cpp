@@ -129,8 +129,7 @@ void TimedSweeps::measureDenoiserGains(double& elapsed) {
     const double expected = lastDenoiseSeconds >= 0 ? lastDenoiseSeconds : r.options.reserveSeconds;
     if (r.options.denoisedVariance && expected <= DenoiseCheckShare * (budget * 0.98 - elapsed)) {
         const auto d0 = std::chrono::steady_clock::now();
-        PixelSums frame = r.film.sums;
-        if (r.film.open.pass >= 0) frame.fold(r.film.open);
+        const PixelSums frame = r.film.sums.withOpen(r.film.open);
         const int ww = r.ww, wh = r.wh;
         FrameHalves halves{frame.evenHalf(ww, wh), frame.oddHalf(ww, wh), frame.emittedHalf(ww, wh, false),
                            frame.emittedHalf(ww, wh, true), aovLayers(r.aovs, r.film.aovs, frame)};
