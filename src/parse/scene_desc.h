@@ -129,9 +129,9 @@ struct ExperimentSettings {
     // (strategies/glass_splitting.h).
     bool glassSplitting = true;
     // Sphere lights' caustics through refracting glass other than the glass
-    // spheres that sphere_caustics connects come from caustic photons in
-    // media; paths leave them out past the vertex that gathered them
-    // (Scene::sphereLightCausticPhotons).
+    // spheres that sphere_caustics connects come from caustic photons where
+    // a method gathers them; paths leave them out past the vertex that
+    // gathered them (Scene::sphereLightCausticPhotons).
     bool causticPhotons = true;
     // Adaptive sampling in timed renders (render --time): blocks of pixels
     // whose share of the time left is spent stop receiving samples

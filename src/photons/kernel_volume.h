@@ -2,8 +2,7 @@
 // centre. Photons land only in that region, so near its surface (the glass
 // around a medium, where a camera path's first vertices gather) the k
 // nearest photons fill less than the sphere, and eq. 4 over the whole
-// sphere's volume reads low: by 11 % on a small glass icosahedron of smoke
-// (docs/method.md, "Caustics of sphere lights").
+// sphere's volume reads low (docs/method.md, "The volume photon map").
 #pragma once
 
 #include "scene/scene.h"

@@ -102,9 +102,10 @@ public:
     // quad outside them (directional lights always are).
     bool deltaLightCaustics = false;
     // The caustics of sphere lights through refracting glass come from
-    // caustic photons gathered at a path's first medium vertex, and the
+    // caustic photons where a method gathers them (the marchers' L_i
+    // samples; the reference where delta lights make it gather), and a
     // path leaves out every sphere light it reaches through bending glass
-    // from that vertex on (docs/method.md, "Caustics of sphere lights"):
+    // from such a vertex on (docs/method.md, "Caustics of sphere lights"):
     // experiments.caustic_photons, a sphere light, bending glass, a
     // scattering medium, and no glass sphere that sphere caustic
     // connections already take (experiments.sphere_caustics).
