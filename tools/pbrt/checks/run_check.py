@@ -56,6 +56,19 @@ def plane_cam(res=(64, 48)):
     return {"position": [0, 4, 2], "look_at": [0, 0, 0], "fov_deg": 30, "resolution": list(res)}
 
 
+def tea_box_scene(medium, box_material, max_depth):
+    """tea_box's camera, sphere light, box and floor (64x48), the box of `box_material` holding `medium`."""
+    return {"camera": {"position": [0, 0.9, 2.6], "look_at": [0, 0.25, 0], "fov_deg": 38, "resolution": [64, 48]},
+            "lights": [{"type": "sphere", "position": [0.5, 1.6, -0.6], "radius": 0.1, "power": 60}],
+            "media": [medium],
+            "surfaces": [{"shape": "box", "transform": {"scale": [0.8, 0.5, 0.5], "rotate": [0, 1, 0, 30],
+                                                         "translate": [0, 0.26, 0]},
+                          "material": box_material, "interior": medium["name"]},
+                         {"shape": "box", "transform": {"scale": [6, 0.1, 6], "translate": [0, -0.05, 0]},
+                          "material": {"type": "diffuse", "albedo": 0.6}}],
+            "render": {"max_depth": max_depth}}
+
+
 def scenes():
     S = {}
     # (a) directional light on a white diffuse plane: L = albedo * E * cos(theta) / pi
@@ -102,15 +115,8 @@ def scenes():
         None, 256, 256, None)
     # (e) a glass box holding a grey medium on a diffuse floor under a sphere light (grey tea_box)
     S["glass_medium"] = (
-        {"camera": {"position": [0, 0.9, 2.6], "look_at": [0, 0.25, 0], "fov_deg": 38, "resolution": [64, 48]},
-         "lights": [{"type": "sphere", "position": [0.5, 1.6, -0.6], "radius": 0.1, "power": 60}],
-         "media": [{"name": "tea", "type": "homogeneous", "sigma_a": 1.0, "sigma_s": 3.0, "g": 0.3}],
-         "surfaces": [{"shape": "box", "transform": {"scale": [0.8, 0.5, 0.5], "rotate": [0, 1, 0, 30],
-                                                      "translate": [0, 0.26, 0]},
-                       "material": {"type": "dielectric", "ior": 1.5}, "interior": "tea"},
-                      {"shape": "box", "transform": {"scale": [6, 0.1, 6], "translate": [0, -0.05, 0]},
-                       "material": {"type": "diffuse", "albedo": 0.6}}],
-         "render": {"max_depth": 64}},
+        tea_box_scene({"name": "tea", "type": "homogeneous", "sigma_a": 1.0, "sigma_s": 3.0, "g": 0.3},
+                      {"type": "dielectric", "ior": 1.5}, 64),
         None, 4096, 4096, None)
     # (d') a point light and a soft-edged spot light over a diffuse plane (intensity, cone, falloff)
     S["point_spot"] = (
@@ -125,16 +131,8 @@ def scenes():
     # (e') tea_box's coloured medium alone (no glass), box of it under a sphere light, many orders of
     # scattering: the spectral-vs-RGB difference for a coloured albedo (a measurement, not a check)
     S["tea_medium_colour"] = (
-        {"camera": {"position": [0, 0.9, 2.6], "look_at": [0, 0.25, 0], "fov_deg": 38, "resolution": [64, 48]},
-         "lights": [{"type": "sphere", "position": [0.5, 1.6, -0.6], "radius": 0.1, "power": 60}],
-         "media": [{"name": "tea", "type": "homogeneous", "sigma_a": [0.6, 1.8, 4.5], "sigma_s": [6.0, 4.0, 2.0],
-                    "g": 0.3}],
-         "surfaces": [{"shape": "box", "transform": {"scale": [0.8, 0.5, 0.5], "rotate": [0, 1, 0, 30],
-                                                      "translate": [0, 0.26, 0]},
-                       "material": {"type": "interface"}, "interior": "tea"},
-                      {"shape": "box", "transform": {"scale": [6, 0.1, 6], "translate": [0, -0.05, 0]},
-                       "material": {"type": "diffuse", "albedo": 0.6}}],
-         "render": {"max_depth": 256}},
+        tea_box_scene({"name": "tea", "type": "homogeneous", "sigma_a": [0.6, 1.8, 4.5], "sigma_s": [6.0, 4.0, 2.0],
+                       "g": 0.3}, {"type": "interface"}, 256),
         None, 1024, 1024, None)
     # (f) the sample cloud as a vdb medium, moved by a transform, under a sun and a constant sky
     vdb = os.path.normpath(os.path.join(HERE, "..", "..", "..", "vdb_samples", "cloud.vdb"))
