@@ -54,13 +54,12 @@ NoiseEstimate noiseOf(const RenderCheckpoint& c, double& meanSamples) {
 }
 
 // The noise at the end of the budget, `left` seconds away, of a method
-// measured at m.rmse after m.seconds: it resumes (tracing its first photons
-// and cache again), then renders samples at the rate it did, later photon
-// passes included, and its noise falls as samples^-m.fall.
+// measured at m.rmse after m.seconds: it resumes with the photons and cache
+// it stopped with, renders samples at the rate it did after its first ones
+// (later photon passes included), and its noise falls as samples^-m.fall.
 double predictedRmse(const PilotMeasurement& m, double left) {
     const double camera = std::max(m.seconds - m.setupSeconds, 1e-3);
-    const double more = std::max(left - m.setupSeconds, 0.0);
-    return m.rmse * std::pow(1 + more / camera, -m.fall);
+    return m.rmse * std::pow(1 + std::max(left, 0.0) / camera, -m.fall);
 }
 
 bool clearlyBetter(double challenger, double incumbent) {

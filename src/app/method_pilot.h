@@ -37,7 +37,7 @@ struct PilotMeasurement {
     // Its noise falls as samples^-fall: 0.5 (finite variance) until a
     // second measurement tells (heavy tails fall slower).
     double fall = 0.5;
-    double predictedRmse = 0;    // at the end of the budget, its setup paid again where it resumes
+    double predictedRmse = 0;    // at the end of the budget
 };
 
 struct MethodPilot {

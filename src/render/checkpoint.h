@@ -10,6 +10,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,15 +19,22 @@
 
 namespace vdbmarch {
 
+struct Illumination;
+
 // Everything a render has accumulated at a sample boundary (the photon pass
 // it was at follows from nextSample): samples
 // [firstSample, nextSample) of every pixel are in the sums.
 struct RenderCheckpoint {
     int nextSample = 0;
     double seconds = 0;   // the run's time so far (counts in --time)
-    // The first photons and cache, part of `seconds`, which a resumed render
-    // traces again (not kept in checkpoint files).
+    // The first photons and cache, part of `seconds`, which a render resumed
+    // from a file traces again (not kept in checkpoint files).
     double setupSeconds = 0;
+    // In memory only, for a render stopped by request: its photons and cache
+    // at the pass it stopped in, which a resume in the same process takes
+    // over instead of tracing them again (method_pilot.cpp's stages). The
+    // resume advances them, so they serve one resume.
+    std::shared_ptr<Illumination> illumination;
     RenderCounters counters;
     PixelSums sums{0};
     PhotonPassSums open;                    // the pass being rendered (pass -1: none)

@@ -168,11 +168,17 @@ RenderState::RenderState(const Scene& scene, const RenderOptions& options)
 void RenderState::buildMarcher() {
     strategies = options.strategies ? options.strategies : StrategySet::build(scene);
     if (aovs.firstEvent()) firstEvents = std::make_unique<FirstEventTracer>(scene);
+    // A resume in this process takes over the photons and cache it stopped
+    // with, if they are still at the pass of its last sample.
+    const RenderCheckpoint* from = hooks ? hooks->resume : nullptr;
+    const bool carried = from && from->illumination && from->nextSample > first &&
+                         from->illumination->photonPass == photonPasses.passOf(from->nextSample - 1);
     arena.execute([&] {
-        illumination = std::make_shared<Illumination>(buildIllumination(scene, request));
+        illumination = carried ? from->illumination
+                               : std::make_shared<Illumination>(buildIllumination(scene, request));
         marcher = makeEstimator(rs.method, scene, illumination, strategies);
     });
-    firstIlluminationSeconds = illumination->stats.seconds;
+    firstIlluminationSeconds = carried ? from->setupSeconds : illumination->stats.seconds;
     result.cacheCells = illumination->cache ? illumination->cache->cells.size() : 0;
     result.photonBytes = illumination->stats.photonBytes;
     result.cacheBytes = illumination->stats.cacheBytes;
@@ -261,6 +267,7 @@ bool RenderState::checkpointAt(int next) {
     c.seconds = std::chrono::duration<double>(now - runStart).count();
     c.counters = counters();
     c.setupSeconds = firstIlluminationSeconds;
+    if (stop) c.illumination = illumination;  // the render ends here
     saveCheckpoint(*hooks, c, film);
     lastCheckpoint = std::chrono::steady_clock::now();
     return stop;

@@ -7,7 +7,9 @@
 // for another version, scene, window or budget is refused with a message
 // naming the file and what differs.
 #include <cstring>
+#include <optional>
 
+#include "illumination/illumination.h"
 #include "render/checkpoint.h"
 #include "support/support.h"
 
@@ -99,6 +101,34 @@ TEST_P(CheckpointMethods, ResumedRenderIsBitIdentical) {
                              str(methodName(GetParam()), aovsAndCrop ? " with AOVs, cropped" : "", ", stopped at ",
                                  state.nextSample));
         }
+    }
+}
+
+// A stop resumed in the same process (auto's pilot stages) takes over the
+// photons and cache the render stopped with instead of tracing them again,
+// and still renders the same bits; a file carries no photons.
+TEST_P(CheckpointMethods, AResumeInMemoryTakesOverThePhotonsAndCache) {
+    TempDir dir("checkpoint_memory");
+    const auto scene = smallScene(GetParam());
+    const RenderResult whole = renderImage(*scene);
+    for (int stopAt : {3, 8}) {
+        std::optional<RenderCheckpoint> state;
+        int boundaries = 0;
+        CheckpointHooks hooks;
+        hooks.everySeconds = 1e-9;  // one sample per chunk
+        hooks.save = [&](const RenderCheckpoint& c) { state = c; };
+        hooks.stopRequested = [&] { return ++boundaries >= stopAt; };
+        RenderOptions options;
+        options.checkpoint = hooks;
+        ASSERT_TRUE(renderImage(*scene, options).interrupted);
+        ASSERT_TRUE(state && state->illumination);
+        const std::shared_ptr<Illumination> carried = state->illumination;
+        expectSameRender(whole, resumed(*scene, {}, *state),
+                         str(methodName(GetParam()), ", in memory, stopped at ", state->nextSample));
+        // The resume advanced the very photons it was handed to the last pass.
+        EXPECT_EQ(carried->photonPass, whole.photonPasses - 1);
+        writeCheckpointFile(dir / "ck", kIdentity, *state);
+        EXPECT_FALSE(readCheckpointFile(dir / "ck", kIdentity).illumination);
     }
 }
 
