@@ -7,6 +7,7 @@
 // for another version, scene, window or budget is refused with a message
 // naming the file and what differs.
 #include <cstring>
+#include <functional>
 #include <optional>
 
 #include "illumination/illumination.h"
@@ -26,17 +27,22 @@ std::unique_ptr<Scene> smallScene(Method method, const std::vector<std::string>&
 
 const CheckpointIdentity kIdentity{"v", "hash", "window", "budget"};
 
-// Renders with a checkpoint at every sample boundary and a stop at the
-// `stopAt`-th; the last state goes through a file. Returns the state.
-RenderCheckpoint interrupted(const Scene& scene, RenderOptions options, int stopAt, const std::string& file) {
+// Renders with a checkpoint handed to `save` at every sample boundary and a
+// stop at the `at`-th.
+void stopAt(const Scene& scene, RenderOptions options, int at,
+            const std::function<void(const RenderCheckpoint&)>& save) {
     int boundaries = 0;
     CheckpointHooks hooks;
     hooks.everySeconds = 1e-9;  // save at every boundary (and take one sample per chunk)
-    hooks.save = [&](const RenderCheckpoint& c) { writeCheckpointFile(file, kIdentity, c); };
-    hooks.stopRequested = [&] { return ++boundaries >= stopAt; };
+    hooks.save = save;
+    hooks.stopRequested = [&] { return ++boundaries >= at; };
     options.checkpoint = hooks;
-    const RenderResult r = renderImage(scene, options);
-    EXPECT_TRUE(r.interrupted);
+    EXPECT_TRUE(renderImage(scene, options).interrupted);
+}
+
+// The same, the last state going through a file. Returns the state.
+RenderCheckpoint interrupted(const Scene& scene, RenderOptions options, int at, const std::string& file) {
+    stopAt(scene, options, at, [&](const RenderCheckpoint& c) { writeCheckpointFile(file, kIdentity, c); });
     return readCheckpointFile(file, kIdentity);
 }
 
@@ -111,16 +117,9 @@ TEST_P(CheckpointMethods, AResumeInMemoryTakesOverThePhotonsAndCache) {
     TempDir dir("checkpoint_memory");
     const auto scene = smallScene(GetParam());
     const RenderResult whole = renderImage(*scene);
-    for (int stopAt : {3, 8}) {
+    for (int at : {3, 8}) {
         std::optional<RenderCheckpoint> state;
-        int boundaries = 0;
-        CheckpointHooks hooks;
-        hooks.everySeconds = 1e-9;  // one sample per chunk
-        hooks.save = [&](const RenderCheckpoint& c) { state = c; };
-        hooks.stopRequested = [&] { return ++boundaries >= stopAt; };
-        RenderOptions options;
-        options.checkpoint = hooks;
-        ASSERT_TRUE(renderImage(*scene, options).interrupted);
+        stopAt(*scene, {}, at, [&](const RenderCheckpoint& c) { state = c; });
         ASSERT_TRUE(state && state->illumination);
         const std::shared_ptr<Illumination> carried = state->illumination;
         expectSameRender(whole, resumed(*scene, {}, *state),
